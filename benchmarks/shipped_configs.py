@@ -1,0 +1,60 @@
+"""Warm run time and accuracy of the shipped configs.
+
+    python benchmarks/shipped_configs.py [--repeat 7]
+
+For each config under configs/: the first call's time (numba compile or cache load included,
+reported on its own), the median and spread of repeated warm runs of ``simulate``, the
+achieved relative error against the independent quadrature reference (``pulloff.reference``)
+and the solver's own error estimate. Single-threaded; numba's threading is not used.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+from pulloff.reference import reference_detachment
+from pulloff.scene import load_scene
+from pulloff.solver import simulate
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=7)
+    args = parser.parse_args()
+    t0 = time.perf_counter()
+    simulate(load_scene(CONFIGS / "seed_flat_punch.yaml"))
+    print(f"first call (JIT compile or cache load): {time.perf_counter() - t0:.2f} s")
+    header = (f"{'config':<18} {'history':<7} {'F_contact [N]':>14} {'vs closed form':>14} "
+              f"{'error':>9} {'estimate':>9} {'steps':>6} {'median ms':>10} {'min-max ms':>14}")
+    print(header)
+    for path in sorted(CONFIGS.glob("*.yaml")):
+        scene = load_scene(path)
+        times = []
+        for _ in range(args.repeat):
+            start = time.perf_counter()
+            res = simulate(scene)
+            times.append(1e3 * (time.perf_counter() - start))
+        p = res.problem
+        if scene.model.history == "exact":
+            ref = reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0,
+                                       rtol=1e-11)
+            error = max(abs(res.t_detach / ref["t_detach"] - 1),
+                        abs(res.F_contact_detach / ref["F_contact"] - 1),
+                        abs(res.F_total_detach / ref["F_total"] - 1))
+            error_text = f"{error:9.1e}"
+        else:
+            error_text = f"{'(closed)':>9}"
+        closed = res.analytic["seed_closed_form_F"]
+        diff = (closed - res.F_contact_detach) / res.F_contact_detach
+        print(f"{path.stem:<18} {scene.model.history:<7} {res.F_contact_detach:14.6g} "
+              f"{diff:+14.2%} {error_text} {res.error_estimate:9.1e} {res.n_steps:6d} "
+              f"{statistics.median(times):10.2f} {min(times):6.2f}-{max(times):<7.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,532 @@
+"""Closed forms of the seed thesis and exact limits of the MDR-Dugdale pull-off model.
+
+Everything here is a plain function of SI quantities (m, s, Pa, Pa s, N).  Equation numbers
+"eq. N" refer to the seed thesis ``seeds/000_cfa5e98cccfc6722.txt``; sections refer to
+``MODEL.md``.  Symbols: shear modulus ``G`` [Pa], viscosity ``eta`` [Pa s], Dugdale stress
+``sigma_c`` [Pa], Dugdale range ``delta`` [m], bond (contact) radius ``a`` [m], pull-off
+velocity ``v`` [m/s].  Incompressible half-space: ``E* = 4 G``.
+
+Two families live here:
+
+* the seed's linearised model (eq. 53 for ``t* = t G / eta``, eq. 48 for the force) and its
+  closed-form approximations (eqs. 59/61/64 for large ``alpha``, 74-78 and 83/85/89 for small
+  ``alpha``);
+* exact limits of the unlinearised model of MODEL.md section 3 that the simulator must
+  reproduce: the elastic (``eta = 0``) MDR-Dugdale punch and the purely viscous (``G = 0``)
+  detachment time (MODEL.md section 5).
+
+Thesis check (eqs. 73/74): the derivatives of eqs. 67-71 are right, and eq. 74 is the correct
+Taylor polynomial, ``f = t/2 + t^2/4 - t^3/12 + 5 t^4/48 - 11 t^5/240 + O(t^6)``.  Eq. 73, which
+is supposed to list ``f^(k)(0)/k!``, instead lists ``f^(k)(0)/(k!/2)`` for ``k >= 2``
+(1/2, -1/6, 5/24, -11/120: twice the true coefficients); the "=" from eq. 73 to eq. 74 is
+therefore not an identity, but eq. 74 and everything derived from it (eqs. 75-83) is right.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+from scipy.optimize import brentq
+
+__all__ = [
+    "ALPHA_SWITCH",
+    "TAYLOR_COEFFS",
+    "alpha",
+    "chi",
+    "V",
+    "dimensionless_groups",
+    "seed_rhs",
+    "seed_t_star",
+    "taylor_poly",
+    "t_star_large_alpha",
+    "t_star_small_alpha",
+    "seed_linearised",
+    "seed_closed_form",
+    "kendall_force",
+    "viscous_force",
+    "viscous_detach_time",
+    "elastic_mdr_dugdale",
+    "cohesive_force",
+]
+
+#: Where the small- and large-alpha approximations of the seed intersect (section 3.3):
+#: both give ``t* = 1 + sqrt(3)`` there.
+ALPHA_SWITCH = 1.5 + math.sqrt(3.0)
+
+#: Coefficients ``c_0..c_5`` of T5 (eq. 74), ``f(t*) = sum c_k t*^k + O(t*^6)``.  Verified
+#: against an independent series expansion of ``f`` (see the module docstring: eq. 73 is off by
+#: a factor 2 for k >= 2, eq. 74 is right).
+TAYLOR_COEFFS = (
+    Fraction(0),
+    Fraction(1, 2),
+    Fraction(1, 4),
+    Fraction(-1, 12),
+    Fraction(5, 48),
+    Fraction(-11, 240),
+)
+
+_EPS = np.finfo(float).eps
+_BRENT_RTOL = 4.0 * _EPS  # the smallest rtol scipy's brentq accepts
+_BRENT_XTOL = 1e-300  # roots may be tiny (t* ~ 2 alpha); let rtol decide
+
+
+def _out(x):
+    """Return a Python float for 0-d input, the array otherwise."""
+    x = np.asarray(x, dtype=float)
+    return float(x) if x.ndim == 0 else x
+
+
+def _series_coeffs_f(n_terms):
+    # Taylor coefficients of f(t) = t + t^2 - (1/2)(1 + 2t + t^2)(1 - e^{-t}), exact rationals:
+    # with e_k = (-1)^(k+1)/k! the coefficients of 1 - e^{-t}, c_n = [n=1] + [n=2]
+    # - (e_n + 2 e_{n-1} + e_{n-2})/2.
+    e = [Fraction(0)] + [Fraction((-1) ** (k + 1), math.factorial(k)) for k in range(1, n_terms)]
+    c = []
+    for n in range(n_terms):
+        cn = Fraction(int(n == 1) + int(n == 2))
+        s = e[n]
+        if n >= 1:
+            s += 2 * e[n - 1]
+        if n >= 2:
+            s += e[n - 2]
+        c.append(cn - s / 2)
+    return c
+
+
+# |c_n| ~ n^2/(2 n!), so 26 terms reach below 1e-22 at |t| = 1.
+_F_SERIES = [float(c) for c in _series_coeffs_f(26)]
+_F_SERIES_MAX_T = 1.0
+
+# Inverse series of eq. 53 about alpha = 0: t* = alpha * (2 - 2 alpha + 16/3 alpha^2 - ...).
+# Used where the brentq bracket would be narrower than the float spacing.
+_T_OVER_ALPHA_SERIES = (2.0, -2.0, 16.0 / 3.0, -20.0, 408.0 / 5.0, -352.0, 100096.0 / 63.0)
+_ALPHA_SERIES_MAX = 1e-4  # next term ~ 8e3 alpha^7: < 1e-21 relative below this
+_ALPHA_FIXED_POINT_MIN = 100.0  # t* > 14: e^{-t*} < 1e-6, the large-alpha iteration contracts
+
+
+def _horner(coeffs, x):
+    acc = np.zeros_like(x) + coeffs[-1]
+    for c in coeffs[-2::-1]:
+        acc = acc * x + c
+    return acc
+
+
+# ---------------------------------------------------------------------------------------------
+# Dimensionless groups (MODEL.md section 4)
+# ---------------------------------------------------------------------------------------------
+
+
+def alpha(G, eta, sigma_c, delta, a, v):
+    """Seed parameter ``alpha = pi delta sigma_c a G / (4 v^2 eta^2)`` (eq. 52), dimensionless.
+
+    Inputs: G [Pa], eta [Pa s], sigma_c [Pa], delta [m], a [m], v [m/s] (scalars or arrays).
+    Returns ``inf`` for ``eta == 0`` with ``G > 0`` (elastic limit) and ``0`` for ``G == 0``.
+    """
+    G = np.asarray(G, dtype=float)
+    eta = np.asarray(eta, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        # split into two O(1)-ish factors so eta**2 cannot underflow on its own
+        val = (0.25 * math.pi) * (sigma_c * a / (v * eta)) * (G * delta / (v * eta))
+    val = np.where(eta == 0, np.inf, val)
+    val = np.where(G == 0, 0.0, val)
+    return _out(val)
+
+
+def chi(G, sigma_c, delta, a):
+    """Elastic cohesive-zone size ``chi = pi G delta / (sigma_c a)``, dimensionless.
+
+    Inputs: G [Pa], sigma_c [Pa], delta [m], a [m].  ``(b - a)/a -> chi`` at detachment in the
+    elastic limit; Kendall's limit is ``chi -> 0``.
+    """
+    return _out(math.pi * np.asarray(G, dtype=float) * delta / (np.asarray(sigma_c, dtype=float) * a))
+
+
+def V(eta, v, sigma_c, a):
+    """Viscous against cohesive stress ``V = eta v / (sigma_c a)``, dimensionless.
+
+    Inputs: eta [Pa s], v [m/s], sigma_c [Pa], a [m].
+    """
+    return _out(np.asarray(eta, dtype=float) * v / (np.asarray(sigma_c, dtype=float) * a))
+
+
+def dimensionless_groups(G, eta, sigma_c, delta, a, v):
+    """The three groups of the seed scene, ``dict(alpha=..., chi=..., V=...)`` (dimensionless).
+
+    Inputs: G [Pa], eta [Pa s], sigma_c [Pa], delta [m], a [m], v [m/s].
+    """
+    return dict(
+        alpha=alpha(G, eta, sigma_c, delta, a, v),
+        chi=chi(G, sigma_c, delta, a),
+        V=V(eta, v, sigma_c, a),
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Eq. 53 and its approximations
+# ---------------------------------------------------------------------------------------------
+
+
+def seed_rhs(t_star):
+    """Right side of eq. 53, ``f(t*) = t*(t*+1) - (t*+1)^2 (1 - exp(-t*))/2`` (dimensionless).
+
+    ``t_star`` is the dimensionless time ``t G / eta`` (scalar or array).  Accurate to a few ulp
+    for all ``t* >= 0``: below ``t* = 1`` a 26-term Taylor series (``f ~ t*/2`` would otherwise
+    cancel), above it ``f = (t*+1)/2 * (2 t* + (t*+1) expm1(-t*))``, whose bracket loses at most
+    a factor ~3 to cancellation.  ``f(inf) = inf``.
+    """
+    t = np.asarray(t_star, dtype=float)
+    small = np.abs(t) < _F_SERIES_MAX_T
+    ts = np.where(small, t, 0.0)
+    series = _horner(_F_SERIES, ts)
+    tl = np.where(small | ~np.isfinite(t), 2.0, t)
+    with np.errstate(over="ignore"):
+        direct = 0.5 * (tl + 1.0) * (2.0 * tl + (tl + 1.0) * np.expm1(-tl))
+    out = np.where(small, series, direct)
+    out = np.where(np.isposinf(t), np.inf, out)
+    out = np.where(np.isnan(t), np.nan, out)
+    return _out(out)
+
+
+def _seed_rhs_prime(t):
+    # eq. 67; both terms positive for t <= 1 and t dominates beyond, so no cancellation
+    return t + 0.5 * (1.0 - t * t) * math.exp(-t)
+
+
+def t_star_large_alpha(alpha):
+    """Large-alpha root of eq. 53, ``t* = sqrt(2 alpha + 1)`` (eq. 59), dimensionless.
+
+    ``alpha`` dimensionless (scalar or array); drops ``exp(-t*)`` from eq. 53 (eq. 54).
+    """
+    al = np.asarray(alpha, dtype=float)
+    with np.errstate(over="ignore"):
+        return _out(np.sqrt(2.0 * al + 1.0))
+
+
+def t_star_small_alpha(alpha):
+    """Small-alpha root of eq. 53 via T2 (eq. 79): ``t* = -1 + sqrt(1 + 4 alpha)`` (eq. 83).
+
+    ``alpha`` dimensionless (scalar or array).  Evaluated as ``4 alpha / (1 + sqrt(1 + 4 alpha))``
+    so that tiny ``alpha`` does not cancel; ``inf -> inf``.
+    """
+    al = np.asarray(alpha, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        val = 4.0 * al / (1.0 + np.sqrt(1.0 + 4.0 * al))
+    val = np.where(np.isposinf(al), np.inf, val)
+    return _out(val)
+
+
+def _t_star_scalar(al):
+    if math.isnan(al) or al < 0:
+        raise ValueError(f"alpha must be >= 0, got {al!r}")
+    if al == 0.0:
+        return 0.0
+    if math.isinf(al):
+        return math.inf
+    if al < _ALPHA_SERIES_MAX:
+        return al * _t_over_alpha_series(al)
+    if al > _ALPHA_FIXED_POINT_MIN:
+        # eq. 53 rearranged: t*^2 = 2 alpha + 1 - (t*+1)^2 e^{-t*}; for t* > 14 the map's slope is
+        # ~ t* e^{-t*}/2 < 1e-5, so the iteration from eq. 59 converges to machine precision in a
+        # few steps.  brentq would fail here once e^{-t*} falls below the float spacing, because
+        # eq. 59 then brackets the root only up to rounding.
+        t = math.sqrt(2.0 * al + 1.0)
+        for _ in range(20):
+            t_new = math.sqrt(2.0 * al + 1.0 - (t + 1.0) ** 2 * math.exp(-t))
+            if t_new == t:
+                break
+            t = t_new
+        return t
+    # Bracket, valid for every alpha > 0 (not only asymptotically):
+    #  * (t+1) e^{-t} <= 1 gives f(t) <= t (t+1)/2, so t* >= -1/2 + sqrt(1/4 + 2 alpha)
+    #    (the large-alpha form eq. 59 shifted by -1/2; ~ the small-alpha form 2 alpha);
+    #  * f is convex (f'' >= 0.44) with f'(0) = 1/2, so f(t) >= t/2, i.e. t* <= 2 alpha (eq. 78);
+    #  * e^{-t} > 0 gives f(t) > (t^2 - 1)/2, i.e. t* < sqrt(2 alpha + 1) (eq. 59).
+    lo = 2.0 * al / (0.5 + math.sqrt(0.25 + 2.0 * al))
+    hi = min(2.0 * al, math.sqrt(2.0 * al + 1.0))
+
+    def res(t):
+        return seed_rhs(t) - al
+
+    # guard against rounding at the bracket ends (never triggered in tests, cheap insurance)
+    while res(lo) > 0:
+        lo *= 0.5
+    while res(hi) < 0:
+        hi *= 2.0
+    t = brentq(res, lo, hi, xtol=_BRENT_XTOL, rtol=_BRENT_RTOL, maxiter=200)
+    # one Newton step: brentq stops within a few ulp, Newton brings it to rounding level
+    t_new = t - res(t) / _seed_rhs_prime(t)
+    if lo <= t_new <= hi:
+        t = t_new
+    return t
+
+
+def _t_over_alpha_series(al):
+    return _horner(_T_OVER_ALPHA_SERIES, np.float64(al)).item()
+
+
+def seed_t_star(alpha):
+    """Root ``t* >= 0`` of eq. 53, ``f(t*) = alpha``; dimensionless in and out.
+
+    ``alpha = 0 -> 0``, ``alpha = inf -> inf``; ``ValueError`` for negative or NaN ``alpha``.
+    Relative accuracy ~1e-15: an inverse series below ``alpha = 1e-4``
+    (``t* = 2 alpha - 2 alpha^2 + 16/3 alpha^3 - ...``), brentq with a rigorous bracket between
+    the small- and large-alpha bounds up to ``alpha = 100``, and a contracting fixed-point
+    iteration on eq. 53 rearranged as ``t*^2 = 2 alpha + 1 - (t*+1)^2 exp(-t*)`` above.
+    Accepts arrays (element by element).
+    """
+    if np.ndim(alpha) > 0:
+        arr = np.asarray(alpha, dtype=float)
+        return np.array([_t_star_scalar(float(x)) for x in arr.ravel()]).reshape(arr.shape)
+    return _t_star_scalar(float(alpha))
+
+
+def taylor_poly(t_star, degree):
+    """Taylor polynomial ``T_degree(t*)`` of ``f`` about 0 (eqs. 74-78), dimensionless.
+
+    ``degree`` in 1..5; ``t_star`` scalar or array.
+    """
+    if degree not in (1, 2, 3, 4, 5):
+        raise ValueError(f"degree must be 1..5, got {degree!r}")
+    coeffs = [float(c) for c in TAYLOR_COEFFS[: degree + 1]]
+    return _out(_horner(coeffs, np.asarray(t_star, dtype=float)))
+
+
+# ---------------------------------------------------------------------------------------------
+# The seed's detachment time and force
+# ---------------------------------------------------------------------------------------------
+
+
+def _check_params(G, eta, sigma_c, delta, a, v):
+    vals = dict(G=G, eta=eta, sigma_c=sigma_c, delta=delta, a=a, v=v)
+    for name, x in vals.items():
+        if not (isinstance(x, (int, float, np.floating, np.integer)) and math.isfinite(x)):
+            raise ValueError(f"{name} must be a finite real scalar, got {x!r}")
+    for name in ("sigma_c", "delta", "a", "v"):
+        if vals[name] <= 0:
+            raise ValueError(f"{name} must be > 0, got {vals[name]!r}")
+    for name in ("G", "eta"):
+        if vals[name] < 0:
+            raise ValueError(f"{name} must be >= 0, got {vals[name]!r}")
+    if G == 0 and eta == 0:
+        raise ValueError("G and eta cannot both be 0 (the half-space would offer no resistance)")
+
+
+def seed_linearised(G, eta, sigma_c, delta, a, v):
+    """The seed's linearised model solved without further approximation.
+
+    Eq. 53 is solved numerically for ``t* = t G / eta``, and the force is eq. 48,
+    ``F = 8 a (G v t + eta v)``.  Inputs: G [Pa], eta [Pa s], sigma_c [Pa], delta [m], a [m],
+    v [m/s] (scalars; G, eta >= 0, not both 0).  Returns
+    ``dict(t_detach=[s], h_detach=[m], F=[N])`` with ``h_detach = v t_detach``.
+
+    Like the seed (eq. 9) this assumes ``h0 = 0`` and ignores any initial lift.
+
+    Limits, reached continuously:
+      * ``eta = 0``: eqs. 93/94, ``t = sqrt(pi delta a sigma_c / (2 G v^2))``,
+        ``F = 8 G v t a`` (= Kendall, eq. 95);
+      * ``G = 0``: ``f ~ t*/2`` gives ``t = 2 alpha eta / G = pi delta sigma_c a / (2 v^2 eta)``
+        and ``F = 8 eta v a`` (eq. 96).
+    """
+    _check_params(G, eta, sigma_c, delta, a, v)
+    G, eta, sigma_c, delta, a, v = map(float, (G, eta, sigma_c, delta, a, v))
+    if eta == 0.0:
+        t = math.sqrt(math.pi * delta * a * sigma_c / (2.0 * G)) / v
+    elif G == 0.0:
+        t = math.pi * delta * sigma_c * a / (2.0 * v * v * eta)
+    else:
+        al = alpha(G, eta, sigma_c, delta, a, v)
+        if al <= 1.0:
+            # t = (t*/alpha) * (alpha eta/G); the second factor does not involve G, so this
+            # stays finite and accurate as G -> 0 (where t* = alpha eta/G alone would be 0/0)
+            ratio = 2.0 if al == 0.0 else (
+                _t_over_alpha_series(al) if al < _ALPHA_SERIES_MAX else seed_t_star(al) / al
+            )
+            t = ratio * math.pi * delta * sigma_c * a / (4.0 * v * v * eta)
+        else:
+            # t = (t*/sqrt(2 alpha + 1)) * (sqrt(2 alpha + 1) eta/G); the second factor is eq. 61,
+            # finite as eta -> 0 even where alpha itself overflows
+            ratio = 1.0 if math.isinf(al) else seed_t_star(al) / math.sqrt(2.0 * al + 1.0)
+            t = ratio * math.sqrt(math.pi * delta * sigma_c * a / (2.0 * G) + (eta * v / G) ** 2) / v
+    F = 8.0 * a * (G * v * t + eta * v)
+    return dict(t_detach=t, h_detach=v * t, F=F)
+
+
+def seed_closed_form(G, eta, sigma_c, delta, a, v):
+    """The seed's closed-form approximation of detachment time and force (section 3).
+
+    Inputs: G [Pa], eta [Pa s], sigma_c [Pa], delta [m], a [m], v [m/s] (scalars; G, eta >= 0,
+    not both 0).  Returns ``dict(t_detach=[s], F=[N], branch=str)``:
+
+      * ``alpha > ALPHA_SWITCH`` (``branch="large_alpha"``): eq. 61,
+        ``t = sqrt((pi delta sigma_c a G + 2 v^2 eta^2)/2) / (G v)``, and eq. 64,
+        ``F = 8 a sqrt((pi delta sigma_c a G + 2 v^2 eta^2)/2) + 8 eta v a``; at ``eta = 0``
+        these are eqs. 93 and 95 (Kendall);
+      * otherwise (``branch="small_alpha"``): eq. 85 written as
+        ``t = pi delta sigma_c a / (v^2 eta (1 + sqrt(1 + 4 alpha)))`` (no 0/0 at ``G = 0``)
+        and eq. 89, ``F = 8 eta v a sqrt(1 + 4 alpha)``; at ``G = 0`` this is ``8 eta v a``.
+
+    Relative to :func:`seed_linearised` the force error is at most ~5.3 % (at the switch; the
+    7.34 % of eq. 90 is the error in ``t*``, which the ``eta v`` term in eq. 48 dilutes).
+    """
+    _check_params(G, eta, sigma_c, delta, a, v)
+    G, eta, sigma_c, delta, a, v = map(float, (G, eta, sigma_c, delta, a, v))
+    al = alpha(G, eta, sigma_c, delta, a, v)
+    if al > ALPHA_SWITCH:
+        root = math.sqrt(0.5 * math.pi * delta * sigma_c * a * G + (v * eta) ** 2)
+        t = root / (G * v)
+        F = 8.0 * a * root + 8.0 * eta * v * a
+        branch = "large_alpha"
+    else:
+        s = math.sqrt(1.0 + 4.0 * al)
+        t = math.pi * delta * sigma_c * a / (v * v * eta * (1.0 + s))
+        F = 8.0 * eta * v * a * s
+        branch = "small_alpha"
+    return dict(t_detach=t, F=F, branch=branch)
+
+
+def kendall_force(G, gamma, a):
+    """Kendall's flat-punch pull-off force ``sqrt(8 pi E* a^3 gamma)`` with ``E* = 4 G`` (eq. 95).
+
+    Inputs: G [Pa], gamma = sigma_c delta [N/m], a [m].  Returns [N].
+    """
+    G = np.asarray(G, dtype=float)
+    return _out(np.sqrt(32.0 * math.pi * G * gamma) * np.asarray(a, dtype=float) ** 1.5)
+
+
+def viscous_force(eta, v, a):
+    """Purely viscous pull-off force ``8 eta v a`` (eq. 96).
+
+    Inputs: eta [Pa s], v [m/s], a [m].  Returns [N].
+    """
+    return _out(8.0 * np.asarray(eta, dtype=float) * v * a)
+
+
+# ---------------------------------------------------------------------------------------------
+# Exact limits of the unlinearised model (MODEL.md section 5)
+# ---------------------------------------------------------------------------------------------
+
+
+def viscous_detach_time(eta, sigma_c, delta, a, v):
+    """Exact detachment time of the model with ``G = 0`` (MODEL.md section 5), in [s].
+
+    Inputs: eta [Pa s], sigma_c [Pa], delta [m], a [m], v [m/s].  With ``G = 0`` the edge
+    condition ``4 eta v = 2 sigma_c sqrt(b^2 - a^2)`` fixes ``b`` for all time,
+    ``S = sqrt(b^2 - a^2)/a = 2 eta v / (sigma_c a)``; the free elements creep as
+    ``u = q t / (4 eta)`` and the gap at ``r = b`` grows linearly,
+    ``gap = t [ (2v/pi) acos(a/b) - sigma_c (b - a) / (pi eta) ]``, so
+    ``t_d = delta / [ ... ]``.  Returns ``inf`` if the bracket is ``<= 0`` (only at ``eta = 0``,
+    where the gap never opens).  Like the seed, ``h0 = 0``.
+    """
+    eta, sigma_c, delta, a, v = map(float, (eta, sigma_c, delta, a, v))
+    S = 2.0 * eta * v / (sigma_c * a)
+    # acos(a/b) = atan(S), b - a = a S^2/(1 + sqrt(1 + S^2)); with sigma_c a S / eta = 2 v the
+    # bracket becomes (2v/pi) [atan(S) - S/(1 + sqrt(1 + S^2))], positive for every S > 0 and
+    # free of both cancellation and a 0/0 at eta = 0
+    denom = (2.0 * v / math.pi) * (math.atan(S) - S / (1.0 + math.sqrt(1.0 + S * S)))
+    if not denom > 0.0:
+        return math.inf
+    return delta / denom
+
+
+def _g_coeffs(n_terms):
+    # g(S) = S atan(S) - (sqrt(1+S^2) - 1) = sum_k g_k S^{2k}, k >= 1,
+    # g_k = (-1)^(k-1)/(2k-1) - binom(1/2, k)
+    out = []
+    binom = Fraction(1)
+    for k in range(1, n_terms + 1):
+        binom = binom * (Fraction(1, 2) - (k - 1)) / k
+        out.append(float(Fraction((-1) ** (k - 1), 2 * k - 1) - binom))
+    return out
+
+
+_G_SERIES = _g_coeffs(6)  # in S^2, starting at S^2: error ~ S^12 < 1e-20 relative for S < 1e-2
+_G_SERIES_MAX_S = 1e-2
+_PI_2_M1 = 0.5 * math.pi - 1.0
+
+
+def _g_gap(S):
+    """``g(S) = S atan(S) - (sqrt(1+S^2) - 1)``: the elastic gap at r = b in units sigma_c a/(pi G)."""
+    if S < _G_SERIES_MAX_S:
+        s2 = S * S
+        return s2 * _horner(_G_SERIES, np.float64(s2)).item()
+    return S * math.atan(S) - S * S / (1.0 + math.sqrt(1.0 + S * S))
+
+
+def elastic_mdr_dugdale(G, sigma_c, delta, a):
+    """Exact elastic (``eta = 0``) MDR-Dugdale flat punch at the onset of detachment.
+
+    Inputs: G [Pa] (> 0), sigma_c [Pa], delta [m], a [m].  With ``S = sqrt(b^2 - a^2)/a`` the two
+    conditions of MODEL.md section 5 read
+
+      * edge: ``2 G h = sigma_c a S``;
+      * gap at ``r = b``: ``(sigma_c a / (pi G)) [S atan(S) - (sqrt(1+S^2) - 1)] = delta``
+        (``acos(a/b) = atan(S)``), i.e. ``g(S) = chi = pi G delta / (sigma_c a)``.
+
+    Returns ``dict(b=[m], h=[m], F_contact=[N], F_total=[N], S=[-])`` with ``h`` the punch lift
+    at detachment, ``F_contact = 8 a G h = 4 sigma_c a^2 S`` and
+    ``F_total = 2 sigma_c [a sqrt(b^2-a^2) + b^2 acos(a/b)] = 2 sigma_c a^2 [S + (1+S^2) atan S]``.
+    ``S`` is returned as well because ``b`` as a float cannot resolve ``b - a`` (= a S^2/2 for
+    thin zones) below ~1e-16 a.  Both forces tend to Kendall (eq. 95) as ``chi -> 0``:
+    ``F_contact/F_K = 1 + 5 chi/12 + ...``, ``F_total/F_K = 1 + 13 chi/12 + ...``.
+    """
+    G, sigma_c, delta, a = map(float, (G, sigma_c, delta, a))
+    if not (G > 0 and sigma_c > 0 and a > 0 and delta >= 0):
+        raise ValueError("need G > 0, sigma_c > 0, a > 0, delta >= 0")
+    c = math.pi * G * delta / (sigma_c * a)
+    if c == 0.0:
+        S = 0.0
+    else:
+        # g(S) <= S^2/2 and g(S) <= (pi/2 - 1) S for all S (g/S = theta - tan(theta/2) increases
+        # to pi/2 - 1 with theta = atan S), so the root is at least the larger of the two
+        # asymptotic solutions; the doubling loop finds the upper end in a step or two.
+        lo = max(math.sqrt(2.0 * c), c / _PI_2_M1)
+        while _g_gap(lo) > c:
+            lo *= 0.5
+        hi = 2.0 * lo
+        while _g_gap(hi) < c:
+            hi *= 2.0
+        S = brentq(lambda s: _g_gap(s) - c, lo, hi, xtol=_BRENT_XTOL, rtol=_BRENT_RTOL, maxiter=200)
+    h = sigma_c * a * S / (2.0 * G)
+    b = a * math.sqrt(1.0 + S * S)
+    F_contact = 8.0 * a * G * h
+    F_total = 2.0 * sigma_c * a * a * (S + (1.0 + S * S) * math.atan(S))
+    return dict(b=b, h=h, F_contact=F_contact, F_total=F_total, S=S)
+
+
+# (1 + S^2) atan(S) - S = sum_{n>=1} (-1)^(n+1) 2 S^(2n+1) / ((2n-1)(2n+1)).  Below S = 0.5 the
+# direct form would lose ~1/S^2 to cancellation; 30 terms of the series reach 0.25^29 ~ 3e-18
+# relative there.  Coefficients listed from S^3 on, in powers of S^2.
+_COH_SERIES = [(-1) ** (n + 1) * 2.0 / ((2 * n - 1) * (2 * n + 1)) for n in range(1, 31)]
+_COH_SERIES_MAX_S = 0.5
+
+
+def _cohesive_bracket(S):
+    """``(1 + S^2) atan(S) - S`` for an array ``S >= 0``, to ~1e-15 relative."""
+    S = np.asarray(S, dtype=float)
+    small = S < _COH_SERIES_MAX_S
+    Ss = np.where(small, S, 0.0)
+    s2 = Ss * Ss
+    series = Ss * s2 * _horner(_COH_SERIES, s2)
+    Sl = np.where(small, 1.0, S)
+    with np.errstate(over="ignore", invalid="ignore"):
+        direct = (1.0 + Sl * Sl) * np.arctan(Sl) - Sl
+    return np.where(small, series, direct)
+
+
+def cohesive_force(sigma_c, a, b):
+    """Force of the cohesive annulus ``a < r < b`` alone, in [N] (MODEL.md section 3).
+
+    ``sigma_c [pi b^2 - 2 a sqrt(b^2-a^2) - 2 b^2 asin(a/b)] = 2 sigma_c a^2 [(1+S^2) atan S - S]``
+    with ``S = sqrt(b^2 - a^2)/a``; inputs sigma_c [Pa], a [m], b [m] (``b >= a``; ``b`` may be an
+    array).  For small ``S`` the force is ``~ (4/3) sigma_c a^2 S^3`` and both forms cancel
+    catastrophically, so a series is used below ``S = 0.5``; accurate to ~1e-15 relative.
+    """
+    b = np.asarray(b, dtype=float)
+    a = float(a)
+    if np.any(b < a):
+        raise ValueError("cohesive_force needs b >= a")
+    # (b - a) is exact for b <= 2a (Sterbenz), so S keeps full relative precision for thin zones
+    S = np.sqrt((b - a) * (b + a)) / a
+    return _out(2.0 * sigma_c * a * a * _cohesive_bracket(S))

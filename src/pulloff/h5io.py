@@ -1,0 +1,180 @@
+"""HDF5 files of a run: written atomically, read back into plain numpy arrays and dicts.
+
+Layout (names are part of the product):
+
+- root attributes ``schema_version``, ``software``, ``software_version``, ``created``,
+  ``scene`` (the full resolved scene as YAML text, so a file reproduces itself), ``complete``;
+- ``history/``: ``t``, ``h``, ``b``, ``gap``, ``F_contact``, ``F_total`` on one time axis
+  (``t`` is attached to the others as their dimension scale), each with a ``unit`` attribute;
+- ``summary`` attributes: the headline numbers at detachment and the run's bookkeeping;
+- ``analytic`` attributes: the closed forms of the seed thesis and the elastic limit;
+- ``snapshots/`` (only if requested): one group per time with ``x`` and ``u`` datasets.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import tempfile
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from . import __version__
+
+SCHEMA_VERSION = 1
+
+HISTORY_UNITS = {"t": "s", "h": "m", "b": "m", "gap": "m", "F_contact": "N", "F_total": "N"}
+
+SUMMARY_UNITS = {
+    "detached": "", "t_detach": "s", "h_detach": "m", "b_detach": "m", "zone_ratio_detach": "1",
+    "F_contact_detach": "N", "F_total_detach": "N", "alpha": "1", "chi": "1", "V": "1",
+    "n_elements": "1", "n_steps": "1", "wall_time": "s", "error_estimate": "1",
+    "t_end": "s", "history": "",
+}
+
+ANALYTIC_UNITS = {
+    "seed_linearised_t_detach": "s", "seed_linearised_F": "N",
+    "seed_closed_form_t_detach": "s", "seed_closed_form_F": "N",
+    "seed_closed_form_branch": "", "kendall_F": "N", "viscous_F": "N",
+    "elastic_F_contact": "N", "elastic_F_total": "N", "elastic_b": "m",
+}
+
+
+def result_to_record(result, scene_yaml: str) -> dict:
+    """The plain-dict view of a :class:`pulloff.solver.Result` that files also load into."""
+    summary = {
+        "detached": bool(result.detached),
+        "t_detach": result.t_detach,
+        "h_detach": result.h_detach,
+        "b_detach": result.b_detach,
+        "zone_ratio_detach": result.zone_ratio_detach,
+        "F_contact_detach": result.F_contact_detach,
+        "F_total_detach": result.F_total_detach,
+        **{name: float(value) for name, value in result.groups.items()},
+        "n_elements": result.n_elements,
+        "n_steps": result.n_steps,
+        "wall_time": result.wall_time,
+        "error_estimate": result.error_estimate,
+        "t_end": result.t_end,
+        "history": result.history_model,
+    }
+    return {
+        "scene": scene_yaml,
+        "summary": summary,
+        "analytic": dict(result.analytic),
+        "history": {name: np.asarray(result.history[name]) for name in HISTORY_UNITS},
+        "snapshots": [{"t": t, "x": np.asarray(x), "u": np.asarray(u)}
+                      for t, x, u in result.snapshots],
+        "complete": True,
+    }
+
+
+def write(path, record: dict) -> Path:
+    """Write ``record`` to ``path`` via a temporary file in the same folder, then rename.
+
+    An exception or Ctrl-C while writing leaves no file behind (and an older file at ``path``
+    untouched), never a truncated one.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(handle)
+    try:
+        with h5py.File(tmp_name, "w") as f:
+            _fill(f, record)
+        os.replace(tmp_name, path)
+    except BaseException:
+        Path(tmp_name).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _fill(f: h5py.File, record: dict) -> None:
+    f.attrs["schema_version"] = SCHEMA_VERSION
+    f.attrs["software"] = "pulloff"
+    f.attrs["software_version"] = __version__
+    f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    f.attrs["scene"] = record["scene"]
+    f.attrs["complete"] = bool(record.get("complete", True))
+
+    hist = f.create_group("history")
+    axis = hist.create_dataset("t", data=np.asarray(record["history"]["t"], dtype=float))
+    axis.attrs["unit"] = HISTORY_UNITS["t"]
+    axis.make_scale("t")
+    for name, unit in HISTORY_UNITS.items():
+        if name == "t":
+            continue
+        ds = hist.create_dataset(name, data=np.asarray(record["history"][name], dtype=float))
+        ds.attrs["unit"] = unit
+        ds.dims[0].attach_scale(axis)
+
+    summary = f.create_group("summary")
+    for name, value in record["summary"].items():
+        summary.attrs[name] = value
+        summary.attrs[f"{name}__unit"] = SUMMARY_UNITS.get(name, "")
+
+    analytic = f.create_group("analytic")
+    for name, value in record["analytic"].items():
+        analytic.attrs[name] = value
+        analytic.attrs[f"{name}__unit"] = ANALYTIC_UNITS.get(name, "")
+
+    if record.get("snapshots"):
+        snaps = f.create_group("snapshots")
+        for i, snap in enumerate(record["snapshots"]):
+            g = snaps.create_group(f"{i:04d}")
+            g.attrs["t"] = snap["t"]
+            g.attrs["t__unit"] = "s"
+            for name in ("x", "u"):
+                ds = g.create_dataset(name, data=np.asarray(snap[name], dtype=float))
+                ds.attrs["unit"] = "m"
+
+
+def _attrs(group) -> dict:
+    out = {}
+    for name, value in group.attrs.items():
+        if name.endswith("__unit"):
+            continue
+        if isinstance(value, np.generic):
+            value = value.item()
+        if isinstance(value, bytes):
+            value = value.decode()
+        out[name] = value
+    return out
+
+
+def load(path) -> dict:
+    """Read a run file into plain Python: the same shape as :func:`result_to_record` gives.
+
+    Raises ``ValueError`` naming the file if it is not a pulloff file of a known schema.
+    """
+    path = Path(path)
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot open as HDF5 ({exc})") from None
+    with f:
+        if f.attrs.get("software") != "pulloff":
+            raise ValueError(f"{path}: not a pulloff result file (no software='pulloff')")
+        version = int(f.attrs["schema_version"])
+        if version != SCHEMA_VERSION:
+            raise ValueError(f"{path}: schema_version {version} is not supported "
+                             f"(this pulloff reads {SCHEMA_VERSION})")
+        record = {
+            "scene": str(f.attrs["scene"]),
+            "software_version": str(f.attrs["software_version"]),
+            "created": str(f.attrs["created"]),
+            "complete": bool(f.attrs["complete"]),
+            "summary": _attrs(f["summary"]),
+            "analytic": _attrs(f["analytic"]),
+            "history": {name: f["history"][name][()] for name in HISTORY_UNITS},
+            "units": {name: str(f["history"][name].attrs["unit"]) for name in HISTORY_UNITS},
+            "snapshots": [],
+        }
+        if "snapshots" in f:
+            for key in sorted(f["snapshots"]):
+                g = f["snapshots"][key]
+                record["snapshots"].append({"t": float(g.attrs["t"]), "x": g["x"][()],
+                                            "u": g["u"][()]})
+    return record

@@ -1,0 +1,73 @@
+"""The console table of a run: simulation beside the seed's closed forms (from a record dict)."""
+
+from __future__ import annotations
+
+import math
+
+
+def _fmt(value, unit=""):
+    if isinstance(value, str):
+        return value
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    text = f"{value:.6g}"
+    return f"{text} {unit}".rstrip()
+
+
+def _rel(model, reference):
+    if not all(isinstance(x, (int, float)) and math.isfinite(x) for x in (model, reference)):
+        return "n/a"
+    if reference == 0:
+        return "n/a"
+    return f"{(model - reference) / abs(reference):+.2%}"
+
+
+def format_table(record: dict, title: str | None = None) -> str:
+    """A short plain-text table: detachment, forces, closed forms and their differences.
+
+    The differences are ``(closed form - simulation) / simulation`` against the simulated
+    ``F_contact`` (the seed's own definition of the pull-off force, eq. 48).
+    """
+    s = record["summary"]
+    an = record["analytic"]
+    lines = []
+    if title:
+        lines.append(title)
+    lines.append(f"  model: history={s.get('history', 'exact')}   alpha = {_fmt(s['alpha'])}   "
+                 f"chi = {_fmt(s['chi'])}   V = {_fmt(s['V'])}")
+    if not s["detached"]:
+        lines.append(f"  no detachment before t_max = {_fmt(s['t_end'], 's')} "
+                     f"(last simulated time); raise numerics.t_max to continue")
+    else:
+        rows = [
+            ("detachment time t", s["t_detach"], "s"),
+            ("lift h", s["h_detach"], "m"),
+            ("cohesive-zone end b", s["b_detach"], "m"),
+            ("(b - a)/a", s.get("zone_ratio_detach"), ""),
+            ("F_contact (eq. 48)", s["F_contact_detach"], "N"),
+            ("F_total (with zone)", s["F_total_detach"], "N"),
+        ]
+        lines.append("  simulation")
+        for label, value, unit in rows:
+            lines.append(f"    {label:<28} {_fmt(value, unit):>16}")
+        lines.append(f"    {'error estimate (relative)':<28} {_fmt(s['error_estimate']):>16}")
+        F = s["F_contact_detach"]
+        t = s["t_detach"]
+        lines.append("  closed forms                           value   vs simulation")
+        compare = [
+            ("seed linearised t (eq. 53)", an.get("seed_linearised_t_detach"), "s", t),
+            ("seed linearised F (eq. 48)", an.get("seed_linearised_F"), "N", F),
+            (f"seed closed form F ({an.get('seed_closed_form_branch', '?')})",
+             an.get("seed_closed_form_F"), "N", F),
+            ("Kendall F (eq. 95)", an.get("kendall_F"), "N", F),
+            ("viscous F = 8 eta v a (eq. 96)", an.get("viscous_F"), "N", F),
+            ("elastic MDR-Dugdale F_contact", an.get("elastic_F_contact"), "N", F),
+            ("elastic MDR-Dugdale F_total", an.get("elastic_F_total"), "N",
+             s["F_total_detach"]),
+        ]
+        for label, value, unit, ref in compare:
+            lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
+    lines.append(f"  elements {s['n_elements']}, steps {s['n_steps']}, "
+                 f"wall time {s['wall_time'] * 1e3:.1f} ms")
+    return "\n".join(lines)
+

@@ -1,0 +1,391 @@
+"""Scene files: the YAML description of one pull-off simulation, validated.
+
+A scene has the sections geometry, material, adhesion, loading, model, numerics and output
+(meanings in MODEL.md sections 1 and 3). All quantities are SI: m, s, Pa, Pa s, J/m^2.
+Every problem is reported as one :class:`SceneError` with one line per problem, naming the
+dotted key, the offending value and the reason, e.g. ``material.G = -1.0: must be >= 0 (...)``.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import numbers
+import re
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Annotated, Any, Literal, Optional
+
+import yaml
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
+from pydantic_core import PydanticCustomError
+
+__all__ = [
+    "SceneError", "SceneLoader", "Scene", "Geometry", "Material", "Adhesion", "Loading", "Model",
+    "Numerics", "Output", "load_scene", "parse_scene", "apply_overrides", "scene_to_yaml",
+]
+
+
+class SceneError(ValueError):
+    """Any problem with a scene; ``problems`` holds one line per problem."""
+
+    def __init__(self, problems: str | Sequence[str]):
+        self.problems = [problems] if isinstance(problems, str) else list(problems)
+        super().__init__("\n".join(self.problems))
+
+
+# --- YAML: PyYAML implements YAML 1.1, where 1e-8 and 3.0e5 are strings, not floats -------------
+_FLOAT_TAG = "tag:yaml.org,2002:float"
+_FLOAT_12 = re.compile(r"""^(?:[-+]?(?:[0-9]+\.[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?
+    |[-+]?[0-9]+[eE][-+]?[0-9]+
+    |[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$""", re.X)
+
+
+def _use_yaml12_floats(cls):
+    # Own copy of the table, so yaml.SafeLoader/SafeDumper themselves stay untouched.
+    cls.yaml_implicit_resolvers = {
+        k: [(tag, rx) for tag, rx in v if tag != _FLOAT_TAG]
+        for k, v in cls.yaml_implicit_resolvers.items()}
+    cls.add_implicit_resolver(_FLOAT_TAG, _FLOAT_12, list("-+0123456789."))
+    return cls
+
+
+@_use_yaml12_floats
+class SceneLoader(yaml.SafeLoader):
+    """SafeLoader with YAML 1.2 floats (``1e-8``, ``3.0e5``, ``.5``, ``5.``) and no duplicate keys."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if key in seen:  # PyYAML would silently keep the last one
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r}", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+@_use_yaml12_floats
+class _SceneDumper(yaml.SafeDumper):
+    """Quotes strings such as '1e5' that SceneLoader would otherwise read back as floats."""
+
+
+# --- field types ---------------------------------------------------------------------------------
+def _bad(reason: str) -> PydanticCustomError:
+    return PydanticCustomError("scene", "{reason}", {"reason": reason})
+
+
+def _bad_line(line: str) -> PydanticCustomError:
+    """A whole problem line for a section-level check; "{p}" stands for the section's prefix."""
+    return PydanticCustomError("scene", "{line}", {"line": line})
+
+
+def _to_float(v: Any) -> float:
+    # bool is an int subclass: without this check `G: true` would silently become 1.0
+    if isinstance(v, bool):
+        raise _bad("must be a number, not a boolean")
+    if isinstance(v, numbers.Real):
+        try:
+            f = float(v)
+        except OverflowError:
+            raise _bad("too large for a float") from None
+    elif isinstance(v, str):
+        try:
+            f = float(v.strip())
+        except ValueError:
+            raise _bad("must be a number") from None
+    else:
+        raise _bad(f"must be a number, not a {type(v).__name__}")
+    if not math.isfinite(f):
+        raise _bad("must be finite")
+    return f
+
+
+def _to_int(v: Any) -> int:
+    f = _to_float(v)
+    if not f.is_integer():
+        raise _bad("must be an integer")
+    return int(f)
+
+
+def _no_bool(v: Any) -> Any:
+    if isinstance(v, bool):
+        raise _bad("must be 1, not a boolean")
+    return v
+
+
+Num = Annotated[float, BeforeValidator(_to_float)]
+Int = Annotated[int, BeforeValidator(_to_int)]
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class Geometry(_Section):
+    """Rigid flat punch bonded over the disc r < radius."""
+
+    kind: Literal["flat_punch"] = Field(description="punch shape, flat_punch")
+    radius: Num = Field(gt=0, description="punch (contact) radius a, m")
+
+
+class Material(_Section):
+    """Incompressible Kelvin-Voigt half-space: shear modulus G in parallel with viscosity eta."""
+
+    kind: Literal["kelvin_voigt"] = Field(description="rheology, kelvin_voigt")
+    G: Num = Field(ge=0, description="shear modulus, Pa")
+    eta: Num = Field(ge=0, description="shear viscosity, Pa s")
+
+    @model_validator(mode="after")
+    def _not_both_zero(self) -> Material:
+        if self.G == 0 and self.eta == 0:
+            raise _bad_line("{p}G = 0.0, {p}eta = 0.0: both zero "
+                            "(need G > 0 or eta > 0; a half-space with neither has no stiffness)")
+        return self
+
+
+class Adhesion(_Section):
+    """Dugdale law; any two of sigma_c, delta, gamma, the third follows from gamma = sigma_c*delta."""
+
+    kind: Literal["dugdale"] = Field(description="cohesive law, dugdale")
+    sigma_c: Optional[Num] = Field(None, gt=0, description="Dugdale cohesive stress, Pa")
+    delta: Optional[Num] = Field(None, gt=0, description="Dugdale range (critical gap), m")
+    gamma: Optional[Num] = Field(None, gt=0, description="work of adhesion, J/m^2 = N/m")
+
+    @model_validator(mode="after")
+    def _resolve(self) -> Adhesion:
+        s, d, g = self.sigma_c, self.delta, self.gamma
+        given = [k for k in ("sigma_c", "delta", "gamma") if getattr(self, k) is not None]
+        if len(given) < 2:
+            missing = [k for k in ("sigma_c", "delta", "gamma") if k not in given]
+            raise _bad_line(", ".join("{p}" + k for k in missing) + ": missing (give any two of "
+                            "sigma_c, delta, gamma" + "".join(
+                                f"; got only {{p}}{k} = {_fmt(getattr(self, k))}" for k in given) + ")")
+        if g is None:
+            g = s * d
+        elif d is None:
+            d = g / s
+        elif s is None:
+            s = g / d
+        elif abs(g - s * d) > 1e-9 * max(g, s * d):
+            # the product is rounded for display only: 6e6*1e-8 is 0.060000000000000005
+            raise _bad_line(f"{{p}}gamma = {_fmt(g)}: inconsistent with sigma_c*delta = "
+                            f"{_fmt(float(f'{s * d:.12g}'))} (sigma_c = {_fmt(s)}, delta = {_fmt(d)})")
+        for k, x in (("sigma_c", s), ("delta", d), ("gamma", g)):
+            if k not in given and not (0 < x < math.inf):  # the product/quotient can over/underflow
+                raise _bad_line(f"{{p}}{k} = {_fmt(x)}: derived from the other two, "
+                                "not a positive finite float")
+        # Given values are kept as written, so a resolved scene re-reads to the same numbers.
+        self.sigma_c, self.delta, self.gamma = s, d, g
+        return self
+
+
+class Loading(_Section):
+    """Punch lift h(t) = h0 + v t."""
+
+    kind: Literal["constant_velocity"] = Field(description="loading protocol, constant_velocity")
+    v: Num = Field(gt=0, description="lift velocity, m/s")
+    h0: Num = Field(0.0, ge=0, description="initial lift, m")
+
+
+class Model(_Section):
+    """Which model of MODEL.md section 3 to solve."""
+
+    history: Literal["exact", "frozen"] = Field(
+        "exact", description="load history of free elements, exact or frozen (seed eq. 31), no unit")
+
+
+class Numerics(_Section):
+    """Accuracy and time span of the solver."""
+
+    rtol: Num = Field(1e-6, ge=1e-12, le=1e-1,
+                      description="target relative accuracy of F and t, dimensionless")
+    t_max: Optional[Num] = Field(None, gt=0, description="end time, s; null: the solver chooses")
+
+
+class Output(_Section):
+    """Where and what to store."""
+
+    path: Optional[str] = Field(None, min_length=1, description="HDF5 result file, path; null: none")
+    history_rows: Int = Field(2000, ge=2, description="max rows of the stored (decimated) history, count")
+    snapshots: list[Annotated[Num, Field(ge=0)]] = Field(
+        default_factory=list, description="times of stored displacement profiles, s")
+
+
+class Scene(BaseModel):
+    """A complete, validated scene; ``schema_version`` is written ``schema`` in the file."""
+
+    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+
+    schema_version: Annotated[Literal[1], BeforeValidator(_no_bool)] = Field(
+        alias="schema", description="scene file format version, must be 1")
+    name: Optional[str] = Field(None, min_length=1, description="scene name, text")
+    geometry: Geometry = Field(description="punch geometry section")
+    material: Material = Field(description="half-space material section")
+    adhesion: Adhesion = Field(description="cohesive law section")
+    loading: Loading = Field(description="loading protocol section")
+    model: Model = Field(default_factory=Model, description="model variant section")
+    numerics: Numerics = Field(default_factory=Numerics, description="solver accuracy section")
+    output: Output = Field(default_factory=Output, description="output section")
+
+    def with_overrides(self, overrides: Sequence[str]) -> Scene:
+        """A new scene with ``section.key=value`` overrides applied and re-validated."""
+        return parse_scene(self.model_dump(by_alias=True), overrides)
+
+
+# --- error formatting ----------------------------------------------------------------------------
+def _fmt(x: Any) -> str:
+    """Short, exact text for a value: 6e6 rather than 6000000.0, 1e-8 rather than 1e-08."""
+    if isinstance(x, bool) or x is None:
+        return {True: "true", False: "false", None: "null"}[x]
+    if isinstance(x, float) and math.isfinite(x) and x != 0:
+        tidy = lambda t: re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", t)  # noqa: E731
+        digits = re.sub(r"e.*|[-.]", "", repr(x)).strip("0")
+        sci, pos = tidy(f"{x:.{max(len(digits) - 1, 0)}e}"), tidy(repr(x))
+        return sci if float(sci) == x and len(sci) < len(pos) else pos
+    s = repr(x)
+    return s if len(s) <= 80 else s[:77] + "..."
+
+
+def _lookup(loc: tuple) -> tuple[type[BaseModel] | None, Any]:
+    """(model class holding the last key, its FieldInfo) for a pydantic error location."""
+    cls, info = Scene, None
+    for i, part in enumerate(loc):
+        if not (isinstance(cls, type) and issubclass(cls, BaseModel)):
+            return None, info
+        fields = {(f.alias or n): f for n, f in cls.model_fields.items()}
+        if part not in fields:
+            return cls, None
+        info = fields[part]
+        if i == len(loc) - 1:
+            return cls, info
+        cls = info.annotation
+    return cls, info
+
+
+def _keys(cls) -> str:
+    return ", ".join(f.alias or n for n, f in cls.model_fields.items())
+
+
+def _given(data: Any, loc: tuple) -> Any:
+    """The value at ``loc`` as written in the scene, or _NOTHING."""
+    for part in loc:
+        try:
+            data = data[part]
+        except (KeyError, IndexError, TypeError):
+            return _NOTHING
+    return data
+
+
+_NOTHING = object()
+
+
+def _problem(err: dict, data: Mapping) -> str:
+    loc = tuple(err["loc"])
+    key = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".") or "scene"
+    typ, ctx, value = err["type"], err.get("ctx") or {}, err.get("input")
+    # pydantic reports some values after coercion (-1 as -1.0); show what the user wrote
+    value = value if (written := _given(data, loc)) is _NOTHING else written
+    owner, info = _lookup(loc)
+    hint = f" ({info.description})" if info is not None and info.description else ""
+    if typ == "scene" and "line" in ctx:
+        return ctx["line"].replace("{p}", f"{key}.")
+    if typ == "scene":
+        reason = ctx["reason"]
+    elif typ == "missing":
+        return f"{key}: missing{hint}"
+    elif typ == "extra_forbidden":
+        allowed = f" (allowed: {_keys(owner)})" if owner is not None else ""
+        return f"{key} = {_fmt(value)}: unknown key{allowed}"
+    elif typ in ("model_type", "model_attributes_type", "dict_type"):
+        sub = info.annotation if info is not None else None
+        sub = sub if isinstance(sub, type) and issubclass(sub, BaseModel) else None
+        reason = "must be a mapping" + (f" with keys {_keys(sub)}" if sub else "")
+        hint = ""
+    elif typ == "literal_error":
+        reason = f"must be one of: {ctx['expected']}"
+    elif typ in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
+        op = {"greater_than": (">", "gt"), "greater_than_equal": (">=", "ge"),
+              "less_than": ("<", "lt"), "less_than_equal": ("<=", "le")}[typ]
+        bound = ctx[op[1]]
+        reason = f"must be {op[0]} {_fmt(int(bound) if float(bound) == 0 else bound)}"
+    elif typ == "string_type":
+        reason = "must be a string"
+    elif typ == "string_too_short":
+        reason = "must not be empty"
+    elif typ == "list_type":
+        reason = "must be a list"
+    else:
+        reason = err["msg"]
+    return f"{key} = {_fmt(value)}: {reason}{hint}"
+
+
+# --- public functions ----------------------------------------------------------------------------
+def apply_overrides(data: Mapping, overrides: Sequence[str]) -> dict:
+    """Copy of ``data`` with each ``a.b.c=value`` applied; the value is read as YAML (1.2 floats).
+
+    Missing intermediate sections are created; whether a key is allowed is left to validation.
+    """
+    if isinstance(overrides, str):  # a lone string would otherwise be iterated per character
+        overrides = [overrides]
+    out = copy.deepcopy(dict(data))
+    for ov in overrides:
+        key, eq, text = str(ov).partition("=")
+        parts = key.strip().split(".")
+        if not eq or not all(p.strip() for p in parts):
+            raise SceneError(f"override {ov!r}: malformed (expected section.key=value)")
+        parts = [p.strip() for p in parts]
+        try:
+            value = yaml.load(text.strip(), Loader=SceneLoader)
+        except yaml.YAMLError as e:
+            raise SceneError(f"override {ov!r}: value is not valid YAML "
+                             f"({getattr(e, 'problem', None) or e})") from None
+        node = out
+        for i, p in enumerate(parts[:-1]):
+            if node.get(p) is None:
+                node[p] = {}
+            if not isinstance(node[p], dict):
+                raise SceneError(f"override {ov!r}: {'.'.join(parts[:i + 1])} = "
+                                 f"{_fmt(node[p])} is not a section")
+            node = node[p]
+        node[parts[-1]] = value
+    return out
+
+
+def parse_scene(data: Mapping, overrides: Sequence[str] = ()) -> Scene:
+    """Validate a scene given as a mapping (as read from YAML), after applying overrides."""
+    if not isinstance(data, Mapping):
+        raise SceneError(f"scene = {_fmt(data)}: must be a mapping of sections "
+                         f"(allowed: {_keys(Scene)})")
+    data = apply_overrides(data, overrides)
+    try:
+        return Scene.model_validate(data)
+    except ValidationError as e:
+        raise SceneError([_problem(err, data) for err in e.errors()]) from None
+
+
+def load_scene(path: str | Path, overrides: Sequence[str] = ()) -> Scene:
+    """Read, override and validate a scene file; every line of an error is prefixed by the path."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as e:
+        raise SceneError(f"{path}: cannot read ({e.strerror or e})") from None
+    try:
+        data = yaml.load(text, Loader=SceneLoader)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(e, "problem", None) or str(e).replace("\n", " ")
+        raise SceneError(f"{path}: invalid YAML{where}: {problem}") from None
+    if data is None:
+        raise SceneError(f"{path}: empty scene file")
+    try:
+        return parse_scene(data, overrides)
+    except SceneError as e:
+        raise SceneError([f"{path}: {p}" for p in e.problems]) from None
+
+
+def scene_to_yaml(scene: Scene) -> str:
+    """The full resolved scene (defaults filled, all three adhesion values) as YAML text."""
+    return yaml.dump(scene.model_dump(by_alias=True), Dumper=_SceneDumper,
+                     sort_keys=False, default_flow_style=False, allow_unicode=True)

@@ -1,0 +1,135 @@
+"""HDF5 round trips, atomic writes and the command line end to end on the shipped configs."""
+
+import math
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from pulloff import h5io
+from pulloff.cli import main
+from pulloff.scene import SceneLoader, load_scene, parse_scene, scene_to_yaml
+from pulloff.solver import simulate
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+SEED = CONFIGS / "seed_flat_punch.yaml"
+
+
+@pytest.fixture(scope="module")
+def seed_record():
+    scene = load_scene(SEED, overrides=["output.snapshots=[0.002, 0.005]"])
+    result = simulate(scene)
+    return scene, result, h5io.result_to_record(result, scene_to_yaml(scene))
+
+
+def test_hdf5_round_trip(tmp_path, seed_record):
+    scene, result, record = seed_record
+    path = h5io.write(tmp_path / "seed.h5", record)
+    back = h5io.load(path)
+    for name in h5io.HISTORY_UNITS:
+        np.testing.assert_array_equal(back["history"][name], result.history[name])
+        assert back["units"][name] == h5io.HISTORY_UNITS[name]
+    assert back["summary"]["F_contact_detach"] == result.F_contact_detach
+    assert back["summary"]["detached"] is True
+    assert back["analytic"]["kendall_F"] == result.analytic["kendall_F"]
+    assert back["complete"]
+    # The file reproduces its scene.
+    assert parse_scene(yaml.load(back["scene"], Loader=SceneLoader)) == scene
+    assert [s["t"] for s in back["snapshots"]] == [0.002, 0.005]
+    with h5py.File(path) as f:
+        for key in ("schema_version", "software", "software_version", "created", "scene"):
+            assert key in f.attrs
+        for name, ds in f["history"].items():
+            assert ds.attrs["unit"] == h5io.HISTORY_UNITS[name]
+        assert f["history/F_total"].dims[0][0].name == "/history/t"
+        for key in ("detached", "t_detach", "h_detach", "b_detach", "F_contact_detach",
+                    "F_total_detach", "alpha", "chi", "V", "n_elements", "n_steps",
+                    "wall_time", "error_estimate"):
+            assert key in f["summary"].attrs
+        for snap in f["snapshots"].values():
+            assert snap["x"].attrs["unit"] == "m" and snap["u"].attrs["unit"] == "m"
+
+
+def test_failed_write_leaves_no_file_and_keeps_the_old_one(tmp_path, seed_record, monkeypatch):
+    _, _, record = seed_record
+    path = h5io.write(tmp_path / "seed.h5", record)
+    before = path.read_bytes()
+
+    def explode(f, rec):
+        f.create_group("history")
+        raise KeyboardInterrupt  # what Ctrl-C looks like mid-write
+
+    monkeypatch.setattr(h5io, "_fill", explode)
+    with pytest.raises(KeyboardInterrupt):
+        h5io.write(path, record)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["seed.h5"]
+
+
+def test_load_rejects_foreign_files(tmp_path):
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f.attrs["software"] = "something else"
+    with pytest.raises(ValueError, match="not a pulloff result file"):
+        h5io.load(other)
+    text = tmp_path / "text.h5"
+    text.write_text("hello")
+    with pytest.raises(ValueError, match="cannot open"):
+        h5io.load(text)
+
+
+@pytest.mark.parametrize("config", sorted(p.name for p in CONFIGS.glob("*.yaml")))
+def test_cli_run_show_plot_on_every_shipped_config(tmp_path, capsys, config):
+    out = tmp_path / "run.h5"
+    assert main(["run", str(CONFIGS / config), "-o", str(out), "-q"]) == 0
+    printed = capsys.readouterr().out
+    for label in ("detachment time", "F_contact", "F_total", "seed closed form", "Kendall",
+                  "alpha", "chi"):
+        assert label in printed
+    assert out.exists() and out.with_suffix(".png").stat().st_size > 10_000
+    assert main(["show", str(out)]) == 0
+    shown = capsys.readouterr().out
+    # The table from the file is the simulation's table (wall-clock line aside).
+    assert shown.splitlines()[1:-1] == printed.splitlines()[1:-2]
+    png = tmp_path / "again.png"
+    assert main(["plot", str(out), "-o", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+
+
+def test_cli_overrides_change_the_scene(tmp_path, capsys):
+    out = tmp_path / "o.h5"
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--set", "material.eta=0",
+                 "--set", "name=elastic_variant"]) == 0
+    rec = h5io.load(out)
+    scene = yaml.load(rec["scene"], Loader=SceneLoader)
+    assert scene["material"]["eta"] == 0.0 and scene["name"] == "elastic_variant"
+    assert rec["summary"]["F_contact_detach"] == pytest.approx(rec["analytic"]["kendall_F"],
+                                                               rel=1e-4)
+
+
+def test_cli_no_detachment_is_reported_not_raised(tmp_path, capsys):
+    out = tmp_path / "short.h5"
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--set", "numerics.t_max=1e-3"]) == 0
+    assert "no detachment before t_max" in capsys.readouterr().out
+    rec = h5io.load(out)
+    assert rec["summary"]["detached"] is False and math.isnan(rec["summary"]["t_detach"])
+
+
+@pytest.mark.parametrize("override,key", [("material.G=-3", "material.G"),
+                                          ("loading.v=0", "loading.v"),
+                                          ("adhesion.gamma=7", "adhesion.gamma"),
+                                          ("numerics.rtl=1e-3", "numerics.rtl")])
+def test_cli_bad_input_fails_before_any_work(tmp_path, capsys, override, key):
+    out = tmp_path / "bad.h5"
+    assert main(["run", str(SEED), "-o", str(out), "--set", override]) == 2
+    err = capsys.readouterr().err
+    assert key in err
+    assert not out.exists()
+
+
+def test_cli_missing_file(tmp_path, capsys):
+    assert main(["run", str(tmp_path / "nope.yaml")]) == 2
+    assert "nope.yaml" in capsys.readouterr().err
+    assert main(["show", str(tmp_path / "nope.h5")]) == 2
