@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 from . import __version__
@@ -28,9 +29,38 @@ def _cmd_run(args) -> int:
     return 0
 
 
+def _cmd_sweep(args) -> int:
+    from . import report, scene as scene_mod, sweep as sweep_mod
+
+    scene = scene_mod.load_scene(args.config, overrides=args.set or ())
+    axes = [sweep_mod.parse_axis(text) for text in args.vary]
+    start = time.perf_counter()
+    result = sweep_mod.sweep(scene, axes, out=args.output, workers=args.workers,
+                             scheduler=args.scheduler, histories=args.histories,
+                             progress=not args.quiet and sys.stderr.isatty())
+    print(report.format_sweep(result))
+    print(f"  {time.perf_counter() - start:.1f} s; wrote {args.output}")
+    return 0
+
+
+def _cmd_validate(args) -> int:
+    from . import validate
+
+    report_path = validate.validate(args.output, rtol=args.rtol, small=args.small,
+                                    workers=args.workers,
+                                    progress=not args.quiet and sys.stderr.isatty())
+    print(f"wrote {report_path} and its figures")
+    return 0
+
+
 def _cmd_show(args) -> int:
     from . import h5io, report
 
+    if _is_sweep(args.file):
+        from .sweep import load_sweep
+
+        print(report.format_sweep(load_sweep(args.file)))
+        return 0
     record = h5io.load(args.file)
     print(report.format_table(record, title=str(args.file)))
     if not record["complete"]:
@@ -38,9 +68,19 @@ def _cmd_show(args) -> int:
     return 0
 
 
+def _is_sweep(path) -> bool:
+    from . import h5io
+
+    with h5io.open_for_reading(path) as f:
+        return f.attrs.get("kind") == "sweep"
+
+
 def _cmd_plot(args) -> int:
     from . import h5io, plots
 
+    if _is_sweep(args.file):
+        raise ValueError(f"{args.file}: a sweep file; plot its table with pulloff.sweep."
+                         f"load_sweep, or see pulloff validate")
     record = h5io.load(args.file)
     png = Path(args.output) if args.output else Path(args.file).with_suffix(".png")
     plots.plot_history(record, png, title=str(args.file))
@@ -64,7 +104,34 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     run.set_defaults(func=_cmd_run)
 
-    show = sub.add_parser("show", help="print the table of a result file")
+    sw = sub.add_parser("sweep", help="run a scene over a grid of parameters, one row each")
+    sw.add_argument("config", help="base scene YAML file")
+    sw.add_argument("--vary", action="append", required=True, metavar="SECTION.KEY=SPEC",
+                    help="an axis: lin:START:STOP:COUNT, log:START:STOP:COUNT or v1,v2,...; "
+                         "repeat for a full product grid")
+    sw.add_argument("-o", "--output", required=True, help="sweep HDF5 file (resumed if it "
+                                                          "holds the same sweep)")
+    sw.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
+                    help="override a base scene value; repeatable")
+    sw.add_argument("--workers", type=int, default=None,
+                    help="worker processes (default: all cores)")
+    sw.add_argument("--scheduler", metavar="ADDRESS",
+                    help="run on a Dask distributed cluster (pip install -e \".[dask]\")")
+    sw.add_argument("--histories", action="store_true", help="also store each history")
+    sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    sw.set_defaults(func=_cmd_sweep)
+
+    val = sub.add_parser("validate", help="redraw the seed's figures against the exact model "
+                                          "and write a validation report")
+    val.add_argument("-o", "--output", default="validation", help="folder (default: validation)")
+    val.add_argument("--rtol", type=float, default=1e-4,
+                     help="accuracy of each simulation (default 1e-4)")
+    val.add_argument("--small", action="store_true", help="coarse grids (a quick check)")
+    val.add_argument("--workers", type=int, default=None, help="worker processes")
+    val.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    val.set_defaults(func=_cmd_validate)
+
+    show = sub.add_parser("show", help="print the table of a run or sweep file")
     show.add_argument("file")
     show.set_defaults(func=_cmd_show)
 
@@ -81,11 +148,12 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (SceneError, ValueError, FileNotFoundError) as exc:
+    except (SceneError, ValueError, OSError) as exc:
         print(f"pulloff {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"pulloff {args.command}: interrupted; no file written", file=sys.stderr)
+        print(f"pulloff {args.command}: interrupted; no partial file written (a sweep keeps "
+              f"its finished rows: run the same command to resume)", file=sys.stderr)
         return 130
 
 

@@ -13,6 +13,7 @@ Layout (names are part of the product):
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import os
 import tempfile
@@ -71,11 +72,13 @@ def result_to_record(result, scene_yaml: str) -> dict:
     }
 
 
-def write(path, record: dict) -> Path:
-    """Write ``record`` to ``path`` via a temporary file in the same folder, then rename.
+@contextlib.contextmanager
+def atomic_file(path):
+    """Open an HDF5 file for writing that appears at ``path`` only once it is complete.
 
-    An exception or Ctrl-C while writing leaves no file behind (and an older file at ``path``
-    untouched), never a truncated one.
+    The file is written under a temporary name in the same folder and renamed at the end; an
+    exception or Ctrl-C leaves no file behind (and an older file at ``path`` untouched),
+    never a truncated one.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -83,19 +86,47 @@ def write(path, record: dict) -> Path:
     os.close(handle)
     try:
         with h5py.File(tmp_name, "w") as f:
-            _fill(f, record)
+            stamp(f)
+            yield f
         os.replace(tmp_name, path)
     except BaseException:
         Path(tmp_name).unlink(missing_ok=True)
         raise
-    return path
 
 
-def _fill(f: h5py.File, record: dict) -> None:
+def stamp(f: h5py.File) -> None:
+    """Root attributes every pulloff file carries."""
     f.attrs["schema_version"] = SCHEMA_VERSION
     f.attrs["software"] = "pulloff"
     f.attrs["software_version"] = __version__
     f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def check_pulloff_file(path, f: h5py.File) -> None:
+    """Raise ``ValueError`` naming ``path`` unless it is a pulloff file of a known schema."""
+    if f.attrs.get("software") != "pulloff":
+        raise ValueError(f"{path}: not a pulloff result file (no software='pulloff')")
+    version = int(f.attrs["schema_version"])
+    if version != SCHEMA_VERSION:
+        raise ValueError(f"{path}: schema_version {version} is not supported "
+                         f"(this pulloff reads {SCHEMA_VERSION})")
+
+
+def open_for_reading(path) -> h5py.File:
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot open as HDF5 ({exc})") from None
+
+
+def write(path, record: dict) -> Path:
+    """Write a run ``record`` (see :func:`result_to_record`) atomically to ``path``."""
+    with atomic_file(path) as f:
+        _fill(f, record)
+    return Path(path)
+
+
+def _fill(f: h5py.File, record: dict) -> None:
     f.attrs["scene"] = record["scene"]
     f.attrs["complete"] = bool(record.get("complete", True))
 
@@ -149,18 +180,11 @@ def load(path) -> dict:
 
     Raises ``ValueError`` naming the file if it is not a pulloff file of a known schema.
     """
-    path = Path(path)
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot open as HDF5 ({exc})") from None
-    with f:
-        if f.attrs.get("software") != "pulloff":
-            raise ValueError(f"{path}: not a pulloff result file (no software='pulloff')")
-        version = int(f.attrs["schema_version"])
-        if version != SCHEMA_VERSION:
-            raise ValueError(f"{path}: schema_version {version} is not supported "
-                             f"(this pulloff reads {SCHEMA_VERSION})")
+    with open_for_reading(path) as f:
+        check_pulloff_file(path, f)
+        if "history" not in f:
+            raise ValueError(f"{path}: not a single-run file (a sweep? read it with "
+                             f"pulloff.sweep.load_sweep)")
         record = {
             "scene": str(f.attrs["scene"]),
             "software_version": str(f.attrs["software_version"]),

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 
 def _fmt(value, unit=""):
     if isinstance(value, str):
@@ -71,3 +73,38 @@ def format_table(record: dict, title: str | None = None) -> str:
                  f"wall time {s['wall_time'] * 1e3:.1f} ms")
     return "\n".join(lines)
 
+
+
+def _short(value) -> str:
+    if isinstance(value, (float, np.floating)):
+        return "n/a" if math.isnan(value) else f"{value:.4g}"
+    return str(value)
+
+
+def format_sweep(result, max_rows: int = 40) -> str:
+    """One line per scene: the varied values, alpha/chi, the simulated force and the seed's."""
+    table = result.table
+    keys = [axis["key"] for axis in result.axes]
+    n = table["index"].size
+    failed = int(np.sum(table["status"] != "ok"))
+    lines = [f"sweep over {' x '.join(keys)}: {n} rows, {failed} failed"]
+    columns = keys + ["alpha", "chi", "F_contact [N]", "closed form", "estimate", "status"]
+    widths = [max(12, len(c)) for c in columns]
+    lines.append("  " + " ".join(f"{c:>{w}}" for c, w in zip(columns, widths)))
+    shown = range(n) if n <= max_rows else list(range(max_rows // 2)) + list(
+        range(n - max_rows // 2, n))
+    previous = -1
+    for r in shown:
+        if r != previous + 1:
+            lines.append(f"  ... {n - max_rows} rows not shown ...")
+        previous = r
+        F = table["F_contact"][r]
+        cells = [_short(table[k][r]) for k in keys] + [
+            _short(table["alpha"][r]), _short(table["chi"][r]), _short(F),
+            _rel(float(table["seed_closed_form_F"][r]), float(F)),
+            _short(table["error_estimate"][r]), str(table["status"][r])]
+        line = "  " + " ".join(f"{c:>{w}}" for c, w in zip(cells, widths))
+        if table["status"][r] != "ok":
+            line += f"  ({table['message'][r]})"
+        lines.append(line)
+    return "\n".join(lines)

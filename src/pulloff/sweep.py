@@ -1,0 +1,392 @@
+"""Parameter sweeps: a full grid of scenes, run in parallel, one table row per scene.
+
+A sweep file (HDF5) holds the base scene (YAML text), the axes (JSON) and a ``table`` group with
+one dataset per column, each with a ``unit`` attribute. It is rewritten atomically every few
+seconds while the sweep runs, so an interruption loses at most the rows of the last few seconds
+and never corrupts what was written; running the same command again resumes: rows already in
+the file are not recomputed. A scene that fails is a row with ``status = "failed"`` and its
+error message; the sweep goes on.
+
+Workers receive :func:`run_point`, a plain function of plain data (base scene text and
+overrides), so each process or Dask worker loads numba's disk cache instead of compiling.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from itertools import product
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from . import h5io
+
+#: Result columns of the table (beside the axes): name -> unit.
+RESULT_COLUMNS = {
+    "alpha": "1", "chi": "1", "V": "1",
+    "t_detach": "s", "h_detach": "m", "b_detach": "m", "zone_ratio_detach": "1",
+    "F_contact": "N", "F_total": "N",
+    "seed_linearised_t_detach": "s", "seed_linearised_F": "N", "seed_closed_form_F": "N",
+    "kendall_F": "N", "viscous_F": "N", "elastic_F_contact": "N", "elastic_F_total": "N",
+    "error_estimate": "1", "n_steps": "1", "wall_time": "s",
+}
+TEXT_COLUMNS = ("status", "message")
+#: Units of the scene values an axis may vary.
+SCENE_UNITS = {
+    "geometry.radius": "m", "material.G": "Pa", "material.eta": "Pa s",
+    "adhesion.sigma_c": "Pa", "adhesion.delta": "m", "adhesion.gamma": "J/m^2",
+    "loading.v": "m/s", "loading.h0": "m", "numerics.rtol": "1", "numerics.t_max": "s",
+}
+#: When a sweep varies one Dugdale parameter, the one held fixed is the first of these that
+#: is not varied (so varying sigma_c keeps delta and changes gamma).
+_ADHESION_KEEP_ORDER = ("delta", "sigma_c", "gamma")
+FLUSH_SECONDS = 2.0
+
+
+class SweepError(ValueError):
+    """A sweep that cannot start: bad axis, or an output file holding another sweep."""
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One ``--vary`` axis: a dotted scene key and its values."""
+
+    key: str
+    values: tuple
+
+    def to_json(self):
+        return {"key": self.key, "values": list(self.values)}
+
+
+def parse_axis(text: str) -> Axis:
+    """Parse ``section.key=SPEC`` with SPEC ``lin:a:b:n``, ``log:a:b:n`` or ``v1,v2,...``.
+
+    ``log`` spaces ``n`` values evenly in log10 between ``a`` and ``b`` (both > 0); list values
+    are read as YAML scalars (numbers as numbers, ``frozen`` as a string).
+    """
+    from .scene import SceneLoader
+
+    import yaml
+
+    key, sep, spec = text.partition("=")
+    key = key.strip()
+    if not sep or not key or not spec.strip():
+        raise SweepError(f"--vary {text!r}: expected SECTION.KEY=lin:a:b:n, log:a:b:n or a "
+                         f"comma-separated list")
+    spec = spec.strip()
+    kind, _, rest = spec.partition(":")
+    if kind in ("lin", "log"):
+        parts = rest.split(":")
+        try:
+            if len(parts) != 3:
+                raise ValueError
+            lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
+        except ValueError:
+            raise SweepError(f"--vary {text!r}: {kind} needs {kind}:START:STOP:COUNT with "
+                             f"numbers and an integer count") from None
+        if n < 1 or not (math.isfinite(lo) and math.isfinite(hi)):
+            raise SweepError(f"--vary {text!r}: count must be >= 1 and ends finite")
+        if kind == "log":
+            if lo <= 0 or hi <= 0:
+                raise SweepError(f"--vary {text!r}: log spacing needs START, STOP > 0")
+            values = np.logspace(math.log10(lo), math.log10(hi), n)
+        else:
+            values = np.linspace(lo, hi, n)
+        return Axis(key, tuple(float(v) for v in values))
+    items = [item.strip() for item in spec.strip("[]").split(",") if item.strip()]
+    if not items:
+        raise SweepError(f"--vary {text!r}: empty list")
+    values = []
+    for item in items:
+        value = yaml.load(item, Loader=SceneLoader)
+        values.append(float(value) if isinstance(value, int) and not isinstance(value, bool)
+                      else value)
+    return Axis(key, tuple(values))
+
+
+def grid(axes: Sequence[Axis]) -> list[tuple]:
+    """The full product of the axes' values, first axis slowest."""
+    return list(product(*(axis.values for axis in axes)))
+
+
+def _override(key: str, value) -> str:
+    return f"{key}={json.dumps(value)}"
+
+
+def _adhesion_drops(axes: Sequence[Axis]) -> list[str]:
+    """Adhesion keys to remove from the resolved base so that exactly two remain given."""
+    varied = [a.key.split(".")[1] for a in axes if a.key.startswith("adhesion.")
+              and a.key.split(".")[1] in _ADHESION_KEEP_ORDER]
+    if not varied:
+        return []
+    if len(varied) > 2:
+        raise SweepError("--vary: at most two of adhesion.sigma_c, delta, gamma can vary "
+                         "(the third follows from gamma = sigma_c delta)")
+    keep = list(varied)
+    for name in _ADHESION_KEEP_ORDER:
+        if len(keep) == 2:
+            break
+        if name not in keep:
+            keep.append(name)
+    return [name for name in _ADHESION_KEEP_ORDER if name not in keep]
+
+
+def run_point(base_yaml: str, overrides: Sequence[str], history: bool = False,
+              drop_adhesion: Sequence[str] = ()) -> dict:
+    """Run one scene of a sweep; never raises (a failure is a row with its message)."""
+    import yaml
+
+    from .scene import SceneLoader, parse_scene
+    from .solver import simulate
+
+    row = {"status": "ok", "message": ""}
+    try:
+        data = yaml.load(base_yaml, Loader=SceneLoader)
+        for name in drop_adhesion:
+            data["adhesion"].pop(name, None)
+        scene = parse_scene(data, overrides=overrides)
+        res = simulate(scene)
+    except Exception as exc:  # a failed scene is data, not the end of the sweep
+        row.update(status="failed", message=f"{type(exc).__name__}: {exc}")
+        return row
+    row.update(res.groups)
+    row.update(
+        detached=res.detached, t_detach=res.t_detach, h_detach=res.h_detach,
+        b_detach=res.b_detach, zone_ratio_detach=res.zone_ratio_detach,
+        F_contact=res.F_contact_detach, F_total=res.F_total_detach,
+        error_estimate=res.error_estimate, n_steps=res.n_steps, wall_time=res.wall_time,
+    )
+    for key in ("seed_linearised_t_detach", "seed_linearised_F", "seed_closed_form_F",
+                "kendall_F", "viscous_F", "elastic_F_contact", "elastic_F_total"):
+        row[key] = res.analytic[key]
+    if history:
+        row["history"] = {name: np.asarray(v) for name, v in res.history.items()}
+    return row
+
+
+def _check_axes(base_yaml: str, axes: Sequence[Axis]) -> None:
+    """Reject axes naming keys the scene does not have, before any work."""
+    import yaml
+
+    from .scene import SceneLoader
+
+    base = yaml.load(base_yaml, Loader=SceneLoader)
+    seen = set()
+    for axis in axes:
+        if axis.key in seen:
+            raise SweepError(f"--vary {axis.key}: given twice")
+        seen.add(axis.key)
+        node = base
+        for part in axis.key.split("."):
+            if not isinstance(node, dict) or part not in node:
+                raise SweepError(f"--vary {axis.key}: no such scene key")
+            node = node[part]
+        if isinstance(node, dict):
+            raise SweepError(f"--vary {axis.key}: is a section, not a value")
+
+
+@dataclass
+class SweepResult:
+    """A sweep's table as plain numpy arrays, one entry per column, rows in grid order."""
+
+    base_scene: str
+    axes: list
+    table: dict
+    histories: dict
+
+    def column(self, name):
+        return self.table[name]
+
+
+def sweep(scene, axes: Sequence[Axis | str], out=None, workers: int | None = None,
+          scheduler: str | None = None, histories: bool = False, progress: bool = False,
+          flush_seconds: float = FLUSH_SECONDS) -> SweepResult:
+    """Run ``scene`` (a :class:`pulloff.scene.Scene`) over the product of ``axes``.
+
+    ``workers`` processes on this machine (default: all cores; 1 runs in this process), or a
+    Dask distributed cluster at ``scheduler``. With ``out`` the table is kept in that HDF5 file
+    and an existing file of the same sweep is resumed.
+    """
+    from .scene import scene_to_yaml
+
+    base_yaml = scene_to_yaml(scene)
+    axes = [parse_axis(a) if isinstance(a, str) else a for a in axes]
+    if not axes:
+        raise SweepError("a sweep needs at least one --vary axis")
+    _check_axes(base_yaml, axes)
+    drops = _adhesion_drops(axes)
+    points = grid(axes)
+    rows: dict[int, dict] = {}
+    if out is not None and os.path.exists(out):
+        rows = _resume(out, base_yaml, axes)
+    todo = [i for i in range(len(points)) if i not in rows]
+    overrides = {i: [_override(axis.key, value) for axis, value in zip(axes, points[i])]
+                 for i in todo}
+
+    bar = None
+    if progress and todo:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(points), initial=len(points) - len(todo), unit="scene",
+                   desc="sweep")
+    last_flush = time.monotonic()
+
+    def record(index, row):
+        nonlocal last_flush
+        rows[index] = row
+        if bar is not None:
+            bar.update(1)
+        if out is not None and time.monotonic() - last_flush > flush_seconds:
+            _write(out, base_yaml, axes, points, rows)
+            last_flush = time.monotonic()
+
+    try:
+        for index, row in _execute(base_yaml, overrides, todo, workers, scheduler, histories,
+                                   drops):
+            record(index, row)
+    finally:
+        if bar is not None:
+            bar.close()
+        if out is not None and (todo or not os.path.exists(out)):
+            _write(out, base_yaml, axes, points, rows)
+    return _as_result(base_yaml, axes, points, rows)
+
+
+def _execute(base_yaml, overrides, todo, workers, scheduler, histories, drops) -> Iterable:
+    if not todo:
+        return
+    if scheduler is not None:
+        yield from _execute_dask(base_yaml, overrides, todo, scheduler, histories, drops)
+        return
+    workers = workers or os.cpu_count() or 1
+    if workers == 1 or len(todo) == 1:
+        for i in todo:
+            yield i, run_point(base_yaml, overrides[i], histories, drops)
+        return
+    with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
+        futures = {pool.submit(run_point, base_yaml, overrides[i], histories, drops): i
+                   for i in todo}
+        try:
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+
+
+def _execute_dask(base_yaml, overrides, todo, scheduler, histories, drops):
+    try:
+        from distributed import Client, as_completed as dask_completed
+    except ImportError:  # the extra is optional
+        raise SweepError("--scheduler needs Dask distributed: pip install -e \".[dask]\"") \
+            from None
+    with Client(scheduler) as client:
+        futures = {}
+        for i in todo:
+            futures[client.submit(run_point, base_yaml, overrides[i], histories, drops,
+                                  pure=False)] = i
+        for future in dask_completed(futures):
+            yield futures[future], future.result()
+
+
+# --- file ----------------------------------------------------------------------------------
+
+def _numeric(axis: Axis) -> bool:
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis.values)
+
+
+def _table(axes, points, rows):
+    indices = sorted(rows)
+    table = {"index": np.asarray(indices, dtype=np.int64)}
+    for a, axis in enumerate(axes):
+        values = [points[i][a] for i in indices]
+        table[axis.key] = (np.asarray(values, dtype=float) if _numeric(axis)
+                           else np.asarray([str(v) for v in values], dtype=object))
+    for name in RESULT_COLUMNS:
+        table[name] = np.asarray([rows[i].get(name, math.nan) for i in indices], dtype=float)
+    table["detached"] = np.asarray([bool(rows[i].get("detached", False)) for i in indices])
+    for name in TEXT_COLUMNS:
+        table[name] = np.asarray([rows[i][name] for i in indices], dtype=object)
+    return table
+
+
+def _write(out, base_yaml, axes, points, rows) -> None:
+    import h5py
+
+    table = _table(axes, points, rows)
+    with h5io.atomic_file(out) as f:
+        f.attrs["kind"] = "sweep"
+        f.attrs["base_scene"] = base_yaml
+        f.attrs["axes"] = json.dumps([axis.to_json() for axis in axes])
+        f.attrs["n_points"] = len(points)
+        f.attrs["complete"] = len(rows) == len(points)
+        g = f.create_group("table")
+        for name, values in table.items():
+            if values.dtype == object:
+                ds = g.create_dataset(name, data=values.astype(str).astype(object),
+                                      dtype=h5py.string_dtype())
+            else:
+                ds = g.create_dataset(name, data=values)
+            ds.attrs["unit"] = RESULT_COLUMNS.get(name, SCENE_UNITS.get(name, ""))
+        hist = [i for i in sorted(rows) if "history" in rows[i]]
+        if hist:
+            h = f.create_group("histories")
+            for i in hist:
+                gi = h.create_group(f"{i:06d}")
+                for name, values in rows[i]["history"].items():
+                    ds = gi.create_dataset(name, data=values)
+                    ds.attrs["unit"] = h5io.HISTORY_UNITS[name]
+
+
+def _read_rows(f, axes) -> dict:
+    g = f["table"]
+    indices = g["index"][()]
+    rows = {}
+    for r, i in enumerate(indices):
+        row = {name: float(g[name][r]) for name in RESULT_COLUMNS}
+        row["detached"] = bool(g["detached"][r])
+        for name in TEXT_COLUMNS:
+            value = g[name][r]
+            row[name] = value.decode() if isinstance(value, bytes) else str(value)
+        if "histories" in f and f"{i:06d}" in f["histories"]:
+            gi = f["histories"][f"{i:06d}"]
+            row["history"] = {name: gi[name][()] for name in gi}
+        rows[int(i)] = row
+    return rows
+
+
+def _resume(out, base_yaml, axes) -> dict:
+    with h5io.open_for_reading(out) as f:
+        h5io.check_pulloff_file(out, f)
+        if f.attrs.get("kind") != "sweep":
+            raise SweepError(f"{out}: exists and is not a sweep file; choose another -o")
+        same = (str(f.attrs["base_scene"]) == base_yaml
+                and json.loads(f.attrs["axes"]) == [axis.to_json() for axis in axes])
+        if not same:
+            raise SweepError(f"{out}: holds a different sweep (base scene or axes differ); "
+                             f"choose another -o or remove the file")
+        return _read_rows(f, axes)
+
+
+def _as_result(base_yaml, axes, points, rows) -> SweepResult:
+    table = _table(axes, points, rows)
+    histories = {i: rows[i]["history"] for i in sorted(rows) if "history" in rows[i]}
+    return SweepResult(base_yaml, [axis.to_json() for axis in axes], table, histories)
+
+
+def load_sweep(path) -> SweepResult:
+    """Read a sweep file into plain numpy arrays (rows in grid order)."""
+    with h5io.open_for_reading(path) as f:
+        h5io.check_pulloff_file(path, f)
+        if f.attrs.get("kind") != "sweep":
+            raise ValueError(f"{path}: not a sweep file")
+        axes = [Axis(a["key"], tuple(a["values"])) for a in json.loads(f.attrs["axes"])]
+        base_yaml = str(f.attrs["base_scene"])
+        rows = _read_rows(f, axes)
+    return _as_result(base_yaml, axes, grid(axes), rows)
