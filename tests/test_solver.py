@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from pulloff import analytic
-from pulloff.scene import parse_scene
+from pulloff.scene import parse_scene, scene_from_groups
 from pulloff.solver import Problem, frozen_detach_time, run_foundation, simulate
 
 
@@ -28,12 +28,7 @@ def make_scene(G=3e5, eta=3e3, sigma_c=5e6, delta=1e-8, a=1e-3, v=1e-3, h0=0.0,
 
 def scene_for_groups(alpha, chi, a=1e-3, G=1e6, sigma_c=1e6, **kw):
     """SI values with the given alpha and chi (MODEL.md section 4)."""
-    delta = chi * sigma_c * a / (math.pi * G)
-    # alpha = chi / (4 V^2) with V = eta v / (sigma_c a); choose v = 1e-3 m/s.
-    V = math.sqrt(chi / (4.0 * alpha))
-    v = 1e-3
-    eta = V * sigma_c * a / v
-    return make_scene(G=G, eta=eta, sigma_c=sigma_c, delta=delta, a=a, v=v, **kw)
+    return scene_from_groups(alpha, chi, G=G, sigma_c=sigma_c, a=a, **kw)
 
 
 # --- limits --------------------------------------------------------------------------------

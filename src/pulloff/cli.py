@@ -30,7 +30,7 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from . import report, scene as scene_mod, sweep as sweep_mod
+    from . import report, scene as scene_mod, sweeps as sweep_mod
 
     scene = scene_mod.load_scene(args.config, overrides=args.set or ())
     axes = [sweep_mod.parse_axis(text) for text in args.vary]
@@ -57,7 +57,7 @@ def _cmd_show(args) -> int:
     from . import h5io, report
 
     if _is_sweep(args.file):
-        from .sweep import load_sweep
+        from .sweeps import load_sweep
 
         print(report.format_sweep(load_sweep(args.file)))
         return 0
@@ -79,7 +79,7 @@ def _cmd_plot(args) -> int:
     from . import h5io, plots
 
     if _is_sweep(args.file):
-        raise ValueError(f"{args.file}: a sweep file; plot its table with pulloff.sweep."
+        raise ValueError(f"{args.file}: a sweep file; plot its table with pulloff.sweeps."
                          f"load_sweep, or see pulloff validate")
     record = h5io.load(args.file)
     png = Path(args.output) if args.output else Path(args.file).with_suffix(".png")

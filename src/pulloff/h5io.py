@@ -184,7 +184,7 @@ def load(path) -> dict:
         check_pulloff_file(path, f)
         if "history" not in f:
             raise ValueError(f"{path}: not a single-run file (a sweep? read it with "
-                             f"pulloff.sweep.load_sweep)")
+                             f"pulloff.sweeps.load_sweep)")
         record = {
             "scene": str(f.attrs["scene"]),
             "software_version": str(f.attrs["software_version"]),

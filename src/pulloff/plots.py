@@ -58,3 +58,133 @@ def _delta(record) -> float | None:
         return float(yaml.safe_load(record["scene"])["adhesion"]["delta"])
     except Exception:  # the figure is still useful without the reference line
         return None
+
+
+# --- validation figures ---------------------------------------------------------------------
+
+def plot_alpha_tstar(curves: dict, path) -> Path:
+    """The seed's Figs. 8/10: alpha against t*, eq. 53 and its approximations vs simulation."""
+    import numpy as np
+
+    from . import analytic
+
+    t = np.logspace(-3, 2.5, 400)
+    fig, (ax, ax_dev) = plt.subplots(1, 2, figsize=(11.0, 4.6), constrained_layout=True)
+    ax.loglog(t, analytic.seed_rhs(t), "k-", lw=1.5, label="eq. 53 (seed, numerical root)")
+    big = t > 1.0
+    ax.loglog(t[big], 0.5 * t[big] ** 2 - 0.5, "k--", lw=1.0, label="parabolic, eq. 56")
+    ax.loglog(t, 0.5 * t + 0.25 * t**2, "k:", lw=1.0, label="Taylor T2, eq. 79")
+    ax.axhline(analytic.ALPHA_SWITCH, color="0.6", lw=0.8)
+    exact = curves["history"] == "exact"
+    for i, chi in enumerate(np.unique(curves["chi"][exact])):
+        sel = exact & (curves["chi"] == chi)
+        ax.loglog(curves["t_star"][sel], curves["alpha"][sel], "o-", ms=3.5, lw=0.8,
+                  color=f"C{i}", label=f"exact simulation, chi = {chi:.0e}")
+    frozen = curves["history"] == "frozen"
+    if frozen.any():
+        chi = curves["chi"][frozen][0]
+        ax.loglog(curves["t_star"][frozen], curves["alpha"][frozen], "kx", ms=6,
+                  label=f"frozen history (eq. 31), chi = {chi:.0e}")
+    ax.set_xlabel("t* = t G / eta at detachment")
+    ax.set_ylabel("alpha")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+
+    root = np.array([analytic.seed_t_star(a) for a in curves["alpha"]])
+    for i, chi in enumerate(np.unique(curves["chi"][exact])):
+        sel = exact & (curves["chi"] == chi)
+        ax_dev.semilogx(curves["alpha"][sel], curves["t_star"][sel] / root[sel], "o-",
+                        ms=3.5, lw=0.8, color=f"C{i}", label=f"exact, chi = {chi:.0e}")
+    if frozen.any():
+        ax_dev.semilogx(curves["alpha"][frozen], curves["t_star"][frozen] / root[frozen], "kx",
+                        label="frozen history")
+    ax_dev.axhline(1.0, color="k", lw=0.8)
+    ax_dev.set_xlabel("alpha")
+    ax_dev.set_ylabel("t* simulated / t* of eq. 53")
+    ax_dev.legend(fontsize=7)
+    ax_dev.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_taylor(path) -> Path:
+    """The seed's Fig. 9: Taylor polynomials T1-T5 of eq. 53's right side."""
+    import numpy as np
+
+    from . import analytic
+
+    t = np.linspace(0.0, 3.0, 300)
+    fig, ax = plt.subplots(figsize=(6.0, 4.4), constrained_layout=True)
+    ax.plot(t, analytic.seed_rhs(t), "k-", lw=2.0, label="eq. 53")
+    for degree in range(1, 6):
+        ax.plot(t, analytic.taylor_poly(t, degree), lw=1.0, label=f"T{degree}")
+    ax.set_ylim(-0.5, 6.0)
+    ax.set_xlabel("t*")
+    ax.set_ylabel("alpha")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_force_speed(speeds, material: dict, path) -> Path:
+    """Pull-off force against speed: simulation, the seed's closed form, the two limits."""
+    import numpy as np
+
+    from . import analytic
+
+    t = speeds.table
+    v = t["loading.v"]
+    e = material
+    elastic = analytic.elastic_mdr_dugdale(e["G"], e["sigma_c"], e["delta"], e["a"])
+    fig, ax = plt.subplots(figsize=(6.8, 4.8), constrained_layout=True)
+    ax.loglog(v, t["F_contact"], "o-", ms=4, label="simulation F_contact")
+    ax.loglog(v, t["F_total"], "s--", ms=3, label="simulation F_total")
+    ax.loglog(v, t["seed_closed_form_F"], "k-", lw=1.0, label="seed closed form (64/89)")
+    vv = np.logspace(np.log10(v.min()), np.log10(v.max()), 200)
+    ax.loglog(vv, 8 * e["eta"] * vv * e["a"], "k:", lw=1.0, label="8 eta v a (eq. 96)")
+    ax.axhline(analytic.kendall_force(e["G"], e["sigma_c"] * e["delta"], e["a"]), color="C3",
+               lw=1.0, ls="-.", label="Kendall (eq. 95)")
+    ax.axhline(elastic["F_total"], color="C2", lw=0.8, ls=":", label="elastic MDR F_total")
+    ax.set_xlabel("pull speed v [m/s]")
+    ax.set_ylabel("pull-off force [N]")
+    ax.set_title(f"G = {e['G']:.2g} Pa, eta = {e['eta']:.2g} Pa s, sigma_c = "
+                 f"{e['sigma_c']:.2g} Pa, delta = {e['delta']:.2g} m, a = {e['a']:.2g} m",
+                 fontsize=8)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_error_map(emap: dict, grid: dict, claim: float, path) -> Path:
+    """Relative error of the seed's closed form against the exact simulation, (alpha, chi)."""
+    import numpy as np
+    from matplotlib.colors import TwoSlopeNorm
+
+    alphas, chis = np.asarray(grid["map_alpha"]), np.asarray(grid["map_chi"])
+    err = np.full((chis.size, alphas.size), np.nan)
+    for a, c, F, Fc in zip(emap["alpha"], emap["chi"], emap["F"], emap["F_closed"]):
+        i = int(np.argmin(np.abs(np.log(chis / c))))
+        j = int(np.argmin(np.abs(np.log(alphas / a))))
+        err[i, j] = 100.0 * (Fc - F) / F
+    fig, ax = plt.subplots(figsize=(7.2, 4.8), constrained_layout=True)
+    limit = max(np.nanmax(np.abs(err)), 100 * claim * 1.2)
+    mesh = ax.pcolormesh(alphas, chis, err, shading="nearest", cmap="RdBu_r",
+                         norm=TwoSlopeNorm(0.0, -limit, limit))
+    fig.colorbar(mesh, ax=ax, label="(closed form - exact) / exact of F_contact [%]")
+    if np.nanmax(np.abs(err)) > 100 * claim:
+        ax.contour(alphas, chis, np.abs(err), levels=[100 * claim], colors="k",
+                   linewidths=1.2)
+    ax.plot([], [], "k-", label=f"|error| = {100 * claim:.2f} % (the seed's claim)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("alpha")
+    ax.set_ylabel("chi = pi G delta / (sigma_c a)")
+    ax.legend(fontsize=8, loc="lower left")
+    return _save(fig, path)
+
+
+def _save(fig, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -389,3 +389,36 @@ def scene_to_yaml(scene: Scene) -> str:
     """The full resolved scene (defaults filled, all three adhesion values) as YAML text."""
     return yaml.dump(scene.model_dump(by_alias=True), Dumper=_SceneDumper,
                      sort_keys=False, default_flow_style=False, allow_unicode=True)
+
+
+def group_values(alpha: float, chi: float, G: float = 1e6, sigma_c: float = 1e6,
+                 a: float = 1e-3, v: float = 1e-3) -> dict:
+    """SI ``eta`` [Pa s] and ``delta`` [m] giving the seed groups ``alpha`` and ``chi``.
+
+    With ``G``, ``sigma_c``, ``a`` and ``v`` fixed: ``delta = chi sigma_c a / (pi G)`` and,
+    since ``alpha = chi / (4 V^2)`` with ``V = eta v / (sigma_c a)``,
+    ``eta = sqrt(chi / (4 alpha)) sigma_c a / v`` (MODEL.md section 4).
+    """
+    import math
+
+    delta = chi * sigma_c * a / (math.pi * G)
+    eta = math.sqrt(chi / (4.0 * alpha)) * sigma_c * a / v
+    return {"eta": eta, "delta": delta}
+
+
+def scene_from_groups(alpha: float, chi: float, history: str = "exact", rtol: float = 1e-6,
+                      G: float = 1e6, sigma_c: float = 1e6, a: float = 1e-3, v: float = 1e-3,
+                      **output) -> Scene:
+    """A seed scene with the given ``alpha`` and ``chi`` (see :func:`group_values`)."""
+    values = group_values(alpha, chi, G=G, sigma_c=sigma_c, a=a, v=v)
+    return parse_scene({
+        "schema": 1,
+        "name": f"alpha={alpha:.3g}, chi={chi:.3g}",
+        "geometry": {"kind": "flat_punch", "radius": a},
+        "material": {"kind": "kelvin_voigt", "G": G, "eta": values["eta"]},
+        "adhesion": {"kind": "dugdale", "sigma_c": sigma_c, "delta": values["delta"]},
+        "loading": {"kind": "constant_velocity", "v": v},
+        "model": {"history": history},
+        "numerics": {"rtol": rtol},
+        "output": output,
+    })

@@ -206,26 +206,43 @@ class SweepResult:
 def sweep(scene, axes: Sequence[Axis | str], out=None, workers: int | None = None,
           scheduler: str | None = None, histories: bool = False, progress: bool = False,
           flush_seconds: float = FLUSH_SECONDS) -> SweepResult:
-    """Run ``scene`` (a :class:`pulloff.scene.Scene`) over the product of ``axes``.
+    """Run ``scene`` (a :class:`pulloff.scene.Scene`) over the full product of ``axes``.
 
     ``workers`` processes on this machine (default: all cores; 1 runs in this process), or a
     Dask distributed cluster at ``scheduler``. With ``out`` the table is kept in that HDF5 file
     and an existing file of the same sweep is resumed.
     """
-    from .scene import scene_to_yaml
-
-    base_yaml = scene_to_yaml(scene)
     axes = [parse_axis(a) if isinstance(a, str) else a for a in axes]
     if not axes:
         raise SweepError("a sweep needs at least one --vary axis")
+    return sweep_points(scene, [axis.key for axis in axes], grid(axes), out=out,
+                        workers=workers, scheduler=scheduler, histories=histories,
+                        progress=progress, flush_seconds=flush_seconds, axes=axes)
+
+
+def sweep_points(scene, keys: Sequence[str], points: Sequence[tuple], out=None,
+                 workers: int | None = None, scheduler: str | None = None,
+                 histories: bool = False, progress: bool = False,
+                 flush_seconds: float = FLUSH_SECONDS, axes=None) -> SweepResult:
+    """Run ``scene`` at explicit ``points``: tuples of values for the dotted ``keys``.
+
+    For sets of scenes that are not a product grid (e.g. a rectangle in ``(alpha, chi)``).
+    """
+    from .scene import scene_to_yaml
+
+    base_yaml = scene_to_yaml(scene)
+    keys = list(keys)
+    points = [tuple(p) for p in points]
+    axes = list(axes) if axes is not None else [
+        Axis(key, tuple(p[i] for p in points)) for i, key in enumerate(keys)]
     _check_axes(base_yaml, axes)
     drops = _adhesion_drops(axes)
-    points = grid(axes)
+    layout = _Layout(base_yaml, keys, points, axes)
     rows: dict[int, dict] = {}
     if out is not None and os.path.exists(out):
-        rows = _resume(out, base_yaml, axes)
+        rows = _resume(out, layout)
     todo = [i for i in range(len(points)) if i not in rows]
-    overrides = {i: [_override(axis.key, value) for axis, value in zip(axes, points[i])]
+    overrides = {i: [_override(key, value) for key, value in zip(keys, points[i])]
                  for i in todo}
 
     bar = None
@@ -235,26 +252,36 @@ def sweep(scene, axes: Sequence[Axis | str], out=None, workers: int | None = Non
         bar = tqdm(total=len(points), initial=len(points) - len(todo), unit="scene",
                    desc="sweep")
     last_flush = time.monotonic()
-
-    def record(index, row):
-        nonlocal last_flush
-        rows[index] = row
-        if bar is not None:
-            bar.update(1)
-        if out is not None and time.monotonic() - last_flush > flush_seconds:
-            _write(out, base_yaml, axes, points, rows)
-            last_flush = time.monotonic()
-
     try:
         for index, row in _execute(base_yaml, overrides, todo, workers, scheduler, histories,
                                    drops):
-            record(index, row)
+            rows[index] = row
+            if bar is not None:
+                bar.update(1)
+            if out is not None and time.monotonic() - last_flush > flush_seconds:
+                _write(out, layout, rows)
+                last_flush = time.monotonic()
     finally:
         if bar is not None:
             bar.close()
         if out is not None and (todo or not os.path.exists(out)):
-            _write(out, base_yaml, axes, points, rows)
-    return _as_result(base_yaml, axes, points, rows)
+            _write(out, layout, rows)
+    return _as_result(layout, rows)
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """What identifies a sweep: its base scene and its points (for resuming)."""
+
+    base_yaml: str
+    keys: list
+    points: list
+    axes: list
+
+    def attrs(self) -> dict:
+        return {"base_scene": self.base_yaml, "keys": json.dumps(self.keys),
+                "points": json.dumps(self.points),
+                "axes": json.dumps([axis.to_json() for axis in self.axes])}
 
 
 def _execute(base_yaml, overrides, todo, workers, scheduler, histories, drops) -> Iterable:
@@ -301,13 +328,15 @@ def _numeric(axis: Axis) -> bool:
     return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis.values)
 
 
-def _table(axes, points, rows):
+def _table(layout: _Layout, rows):
     indices = sorted(rows)
     table = {"index": np.asarray(indices, dtype=np.int64)}
-    for a, axis in enumerate(axes):
-        values = [points[i][a] for i in indices]
-        table[axis.key] = (np.asarray(values, dtype=float) if _numeric(axis)
-                           else np.asarray([str(v) for v in values], dtype=object))
+    for a, key in enumerate(layout.keys):
+        values = [layout.points[i][a] for i in indices]
+        numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                      for v in (p[a] for p in layout.points))
+        table[key] = (np.asarray(values, dtype=float) if numeric
+                      else np.asarray([str(v) for v in values], dtype=object))
     for name in RESULT_COLUMNS:
         table[name] = np.asarray([rows[i].get(name, math.nan) for i in indices], dtype=float)
     table["detached"] = np.asarray([bool(rows[i].get("detached", False)) for i in indices])
@@ -316,16 +345,16 @@ def _table(axes, points, rows):
     return table
 
 
-def _write(out, base_yaml, axes, points, rows) -> None:
+def _write(out, layout: _Layout, rows) -> None:
     import h5py
 
-    table = _table(axes, points, rows)
+    table = _table(layout, rows)
     with h5io.atomic_file(out) as f:
         f.attrs["kind"] = "sweep"
-        f.attrs["base_scene"] = base_yaml
-        f.attrs["axes"] = json.dumps([axis.to_json() for axis in axes])
-        f.attrs["n_points"] = len(points)
-        f.attrs["complete"] = len(rows) == len(points)
+        for name, value in layout.attrs().items():
+            f.attrs[name] = value
+        f.attrs["n_points"] = len(layout.points)
+        f.attrs["complete"] = len(rows) == len(layout.points)
         g = f.create_group("table")
         for name, values in table.items():
             if values.dtype == object:
@@ -344,7 +373,7 @@ def _write(out, base_yaml, axes, points, rows) -> None:
                     ds.attrs["unit"] = h5io.HISTORY_UNITS[name]
 
 
-def _read_rows(f, axes) -> dict:
+def _read_rows(f) -> dict:
     g = f["table"]
     indices = g["index"][()]
     rows = {}
@@ -361,32 +390,35 @@ def _read_rows(f, axes) -> dict:
     return rows
 
 
-def _resume(out, base_yaml, axes) -> dict:
+def _layout_of(f) -> _Layout:
+    axes = [Axis(a["key"], tuple(a["values"])) for a in json.loads(f.attrs["axes"])]
+    points = [tuple(p) for p in json.loads(f.attrs["points"])]
+    return _Layout(str(f.attrs["base_scene"]), json.loads(f.attrs["keys"]), points, axes)
+
+
+def _resume(out, layout: _Layout) -> dict:
     with h5io.open_for_reading(out) as f:
         h5io.check_pulloff_file(out, f)
         if f.attrs.get("kind") != "sweep":
             raise SweepError(f"{out}: exists and is not a sweep file; choose another -o")
-        same = (str(f.attrs["base_scene"]) == base_yaml
-                and json.loads(f.attrs["axes"]) == [axis.to_json() for axis in axes])
-        if not same:
-            raise SweepError(f"{out}: holds a different sweep (base scene or axes differ); "
+        if _layout_of(f).attrs() != layout.attrs():
+            raise SweepError(f"{out}: holds a different sweep (base scene or points differ); "
                              f"choose another -o or remove the file")
-        return _read_rows(f, axes)
+        return _read_rows(f)
 
 
-def _as_result(base_yaml, axes, points, rows) -> SweepResult:
-    table = _table(axes, points, rows)
+def _as_result(layout: _Layout, rows) -> SweepResult:
     histories = {i: rows[i]["history"] for i in sorted(rows) if "history" in rows[i]}
-    return SweepResult(base_yaml, [axis.to_json() for axis in axes], table, histories)
+    return SweepResult(layout.base_yaml, [axis.to_json() for axis in layout.axes],
+                       _table(layout, rows), histories)
 
 
 def load_sweep(path) -> SweepResult:
-    """Read a sweep file into plain numpy arrays (rows in grid order)."""
+    """Read a sweep file into plain numpy arrays (rows in point order)."""
     with h5io.open_for_reading(path) as f:
         h5io.check_pulloff_file(path, f)
         if f.attrs.get("kind") != "sweep":
             raise ValueError(f"{path}: not a sweep file")
-        axes = [Axis(a["key"], tuple(a["values"])) for a in json.loads(f.attrs["axes"])]
-        base_yaml = str(f.attrs["base_scene"])
-        rows = _read_rows(f, axes)
-    return _as_result(base_yaml, axes, grid(axes), rows)
+        layout = _layout_of(f)
+        rows = _read_rows(f)
+    return _as_result(layout, rows)
