@@ -122,8 +122,9 @@ def test_histories_on_request(seed, tmp_path):
 
 
 def test_sweep_on_a_local_dask_cluster(seed):
-    distributed = pytest.importorskip("distributed")  # the [dask] extra, installed for tests
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    from distributed import LocalCluster  # the [dask] extra; part of the test extra too
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   host="127.0.0.1", dashboard_address="127.0.0.1:0") as cluster:
         remote = sw.sweep(seed, ["loading.v=log:1e-4:1e-2:4"],
                           scheduler=cluster.scheduler_address)

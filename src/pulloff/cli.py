@@ -124,8 +124,8 @@ def build_parser() -> argparse.ArgumentParser:
     val = sub.add_parser("validate", help="redraw the seed's figures against the exact model "
                                           "and write a validation report")
     val.add_argument("-o", "--output", default="validation", help="folder (default: validation)")
-    val.add_argument("--rtol", type=float, default=1e-4,
-                     help="accuracy of each simulation (default 1e-4)")
+    val.add_argument("--rtol", type=float, default=1e-5,
+                     help="accuracy of each simulation (default 1e-5)")
     val.add_argument("--small", action="store_true", help="coarse grids (a quick check)")
     val.add_argument("--workers", type=int, default=None, help="worker processes")
     val.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
