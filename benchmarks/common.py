@@ -67,21 +67,20 @@ class Timing:
 
 
 def time_call(fn, min_repeats: int = 5, min_total: float = 0.2, max_repeats: int = 200,
-              warmup: bool = True, sample_floor: float = 1e-3) -> Timing:
-    """Time ``fn()``: at least ``min_repeats`` samples and at least ``min_total`` seconds.
+              sample_floor: float = 1e-3):
+    """Time ``fn()`` warm: at least ``min_repeats`` samples and at least ``min_total`` seconds.
 
-    ``warmup`` makes one untimed call first (JIT compile, caches). Calls shorter than
-    ``sample_floor`` seconds are timed in batches of 10^j calls per sample, so that the clock's
-    resolution and the loop overhead stay negligible; the reported times are per call.
+    The caller warms ``fn`` up first (one call per method compiles or loads numba's kernels;
+    after that every call of the method is warm). Calls shorter than ``sample_floor`` seconds
+    are timed in batches of 10^j calls per sample so that the clock's resolution and the loop
+    overhead stay negligible. Returns ``(Timing, last result of fn)``, times per call.
     """
     clock = time.perf_counter
-    if warmup:
-        fn()
     number = 1
     while True:
         start = clock()
         for _ in range(number):
-            fn()
+            result = fn()
         first = clock() - start
         if first >= sample_floor or number >= 10**6:
             break
@@ -91,12 +90,12 @@ def time_call(fn, min_repeats: int = 5, min_total: float = 0.2, max_repeats: int
     while len(samples) < min_repeats or (total < min_total and len(samples) < max_repeats):
         start = clock()
         for _ in range(number):
-            fn()
+            result = fn()
         elapsed = clock() - start
         samples.append(elapsed / number)
         total += elapsed
     q1, _, q3 = statistics.quantiles(samples, n=4, method="inclusive")
-    return Timing(statistics.median(samples), min(samples), q1, q3, len(samples), number)
+    return Timing(statistics.median(samples), min(samples), q1, q3, len(samples), number), result
 
 
 # --------------------------------------------------------------------------------------------

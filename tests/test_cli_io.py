@@ -133,3 +133,28 @@ def test_cli_missing_file(tmp_path, capsys):
     assert main(["run", str(tmp_path / "nope.yaml")]) == 2
     assert "nope.yaml" in capsys.readouterr().err
     assert main(["show", str(tmp_path / "nope.h5")]) == 2
+
+
+def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypatch):
+    from pulloff import solver
+
+    real = solver.kernels.march
+    calls = []
+
+    def march_then_interrupt(*args):
+        calls.append(1)
+        if len(calls) == 60:  # well inside the finest level
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(solver.kernels, "march", march_then_interrupt)
+    out = tmp_path / "cut.h5"
+    assert main(["run", str(SEED), "-o", str(out), "-q"]) == 130
+    assert "complete = False" in capsys.readouterr().err
+    rec = h5io.load(out)
+    assert rec["complete"] is False
+    t = rec["history"]["t"]
+    assert t.size > 2 and np.all(np.diff(t) > 0) and np.all(np.isfinite(rec["history"]["gap"]))
+    assert rec["history"]["gap"][-1] < 1e-8  # cut before detachment
+    assert main(["show", str(out)]) == 0
+    assert "INCOMPLETE" in capsys.readouterr().out

@@ -26,6 +26,10 @@ def _cmd_run(args) -> int:
     plots.plot_history(record, png, title=scene.name or Path(args.config).stem)
     print(report.format_table(record, title=f"{scene.name or args.config}"))
     print(f"  wrote {out} and {png}")
+    if not result.complete:
+        print("  interrupted: the file holds the history computed so far and is marked "
+              "complete = False", file=sys.stderr)
+        return 130
     return 0
 
 

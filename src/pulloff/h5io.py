@@ -68,7 +68,7 @@ def result_to_record(result, scene_yaml: str) -> dict:
         "history": {name: np.asarray(result.history[name]) for name in HISTORY_UNITS},
         "snapshots": [{"t": t, "x": np.asarray(x), "u": np.asarray(u)}
                       for t, x, u in result.snapshots],
-        "complete": True,
+        "complete": bool(result.complete),
     }
 
 

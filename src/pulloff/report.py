@@ -37,7 +37,10 @@ def format_table(record: dict, title: str | None = None) -> str:
         lines.append(title)
     lines.append(f"  model: history={s.get('history', 'exact')}   alpha = {_fmt(s['alpha'])}   "
                  f"chi = {_fmt(s['chi'])}   V = {_fmt(s['V'])}")
-    if not s["detached"]:
+    if not record.get("complete", True):
+        lines.append(f"  INCOMPLETE: interrupted at t = {_fmt(s['t_end'], 's')}; the history "
+                     f"holds what was computed until then")
+    elif not s["detached"]:
         lines.append(f"  no detachment before t_max = {_fmt(s['t_end'], 's')} "
                      f"(last simulated time); raise numerics.t_max to continue")
     else:

@@ -144,6 +144,7 @@ class FoundationRun:
     n_elements: int
     n_steps: int
     snapshots: list = field(default_factory=list)  # (t, sigma, U)
+    interrupted: bool = False  # Ctrl-C arrived: the run holds what was computed until then
 
 
 def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
@@ -227,11 +228,19 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     stops = sorted((set(range(chunk, n_stop, chunk)) | capture_steps | {n_stop}) - {0})
     step = 0
     crossed = False
+    interrupted = False
     for stop in stops:
         step_before = step
-        step, n_born, crossed = kernels.march(
-            sig_pre, U_pre, sig_born, U_born, n_born, step, stop, k, c, h0, dt, decay,
-            w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old, t_out, gap_out)
+        try:
+            step, n_born, crossed = kernels.march(
+                sig_pre, U_pre, sig_born, U_born, n_born, step, stop, k, c, h0, dt, decay,
+                w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old, t_out,
+                gap_out)
+        except KeyboardInterrupt:
+            # Compiled code does not see signals; Python raises on return, before ``step``
+            # is updated, so the arrays hold a consistent state up to ``step``.
+            interrupted = True
+            break
         if progress is not None:
             progress(step - step_before)
         if crossed:
@@ -245,7 +254,7 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
                                                       ts / dt - n0, ts)))
     t_detach = _crossing_time(t_out, gap_out, step) if crossed else math.nan
     return FoundationRun(dt, t_out[:step + 1].copy(), gap_out[:step + 1].copy(), t_detach,
-                         sig_pre.size + n_born, step, snapshots)
+                         sig_pre.size + n_born, step, snapshots, interrupted)
 
 
 def _interpolate_field(problem, field0, field1, weight, t):
@@ -285,6 +294,7 @@ class Result:
     F_contact_detach: float  # N
     F_total_detach: float  # N
     error_estimate: float  # relative, of t and F
+    complete: bool  # False after Ctrl-C: the history holds what was computed until then
     n_elements: int
     n_steps: int
     wall_time: float  # s
@@ -369,6 +379,8 @@ def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress):
     if coarse.n_steps < n // 2 and math.isfinite(coarse.t_detach) and coarse.t_detach > 0:
         t_ref = min(t_ref, 1.25 * coarse.t_detach * (1.0 + 2.0 / n))
         levels = [run_foundation(problem, t_ref / n, steps_to_cover(n))]
+    if levels[-1].interrupted:
+        return levels[-1], math.nan
     while True:
         n *= 2
         bar = None
@@ -382,6 +394,8 @@ def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress):
         finally:
             if bar is not None:
                 bar.close()
+        if levels[-1].interrupted:
+            return levels[-1], math.nan
         if len(levels) < 3 and n < _MAX_STEPS:
             continue
         estimate = _error_estimate(problem, levels)
@@ -464,6 +478,7 @@ def _assemble(scene, problem: Problem, run: FoundationRun, error_estimate: float
         F_contact_detach=float(problem.contact_force(td)) if detached else nan,
         F_total_detach=float(problem.total_force(td)) if detached else nan,
         error_estimate=float(error_estimate),
+        complete=not run.interrupted,
         n_elements=int(run.n_elements),
         n_steps=int(run.n_steps),
         wall_time=wall,

@@ -154,6 +154,9 @@ def run_point(base_yaml: str, overrides: Sequence[str], history: bool = False,
     except Exception as exc:  # a failed scene is data, not the end of the sweep
         row.update(status="failed", message=f"{type(exc).__name__}: {exc}")
         return row
+    if not res.complete:
+        # Ctrl-C reached the stepper: a cut-short scene is not a row; stop like the parent.
+        raise KeyboardInterrupt
     row.update(res.groups)
     row.update(
         detached=res.detached, t_detach=res.t_detach, h_detach=res.h_detach,
