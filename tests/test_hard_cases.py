@@ -66,9 +66,8 @@ def test_no_detachment_before_t_max():
     assert res.t_end == pytest.approx(5e-3, rel=1e-12)
 
 
-@pytest.mark.parametrize("rtol", [1e-3, 1e-8])
-@pytest.mark.parametrize("name", ["near_elastic", "alpha_1e6", "wide_zone_1e2",
-                                  "nanometre_punch"])
+@pytest.mark.parametrize("rtol", [1e-3, 1e-6, 1e-8])
+@pytest.mark.parametrize("name", DETACHING)
 def test_each_rtol_on_hard_cases(name, rtol):
     res = run(name, rtol)
     p = res.problem
