@@ -58,8 +58,7 @@ class MolRun:
 
     t_detach: float  # nan if the event was not reached
     n_elements: int
-    n_rhs: int  # right-hand-side evaluations
-    n_steps: int  # accepted steps
+    n_steps: int  # accepted steps of the integrator
 
 
 def mol_detachment(problem: Problem, n_elements: int, rtol: float,
@@ -92,9 +91,8 @@ def mol_detachment(problem: Problem, n_elements: int, rtol: float,
         # trapezoid of v in x over the nodes inside the zone, plus the partial interval to b,
         # where v = U/q -> 0 (the element at b has just entered and has not moved yet).
         S = k * (h0 + t) + c
-        m = int(np.searchsorted(sigma, S))  # nodes with sigma < S
-        if m == 0:
-            return (2.0 / math.pi) * (h0 + t) * math.atan(S) - 1.0
+        # Nodes with sigma < S: at least the one at sigma = 0, since S >= s0 >= c > 0.
+        m = int(np.searchsorted(sigma, S))
         sg = sigma[:m]
         v = U[:m] / np.sqrt((S - sg) * (S + sg))
         integral = 0.5 * np.dot(v[1:] + v[:-1], dx[:m - 1])
@@ -117,8 +115,7 @@ def mol_detachment(problem: Problem, n_elements: int, rtol: float,
                     atol=rtol * (h0 + t_ref), events=gap_minus_one, dense_output=False,
                     **jac_options)
     events = sol.t_events[0]
-    return MolRun(float(events[0]) if events.size else math.nan, n, int(sol.nfev),
-                  int(sol.t.size - 1))
+    return MolRun(float(events[0]) if events.size else math.nan, n, int(sol.t.size - 1))
 
 
 # --------------------------------------------------------------------------------------------

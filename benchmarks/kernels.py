@@ -63,7 +63,7 @@ def setup(problem: Problem, n: int):
     S = sig_born[-1] + k * dt
     U_pre = 0.5 * np.sqrt((S - sig_pre) * (S + sig_pre)) / k
     U_born = 0.5 * np.sqrt((S - sig_born) * (S + sig_born)) / k
-    return dict(k=k, c=c, dt=dt, s0=s0, S=S, sig_pre=sig_pre, U_pre=U_pre, sig_born=sig_born,
+    return dict(k=k, c=c, dt=dt, S=S, sig_pre=sig_pre, U_pre=U_pre, sig_born=sig_born,
                 U_born=U_born)
 
 
@@ -96,8 +96,8 @@ def kernel_calls(problem: Problem, n: int):
 
 def march_call(problem: Problem, n_steps: int):
     """A call of ``kernels.march`` over ``n_steps`` steps from t = 0, set up as run_foundation
-    does, with the step chosen so that the gap stays below 1 (no early stop). Returns the call
-    and its number of element-steps."""
+    does, with the step chosen so that the gap stays below 1 (no early stop). Returns the call,
+    its number of element-steps and the number of elements at the end."""
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     t_ref = frozen_detach_time(problem)
     # Half the frozen detachment time: the exact gap is still well below delta there.
@@ -137,7 +137,7 @@ def march_call(problem: Problem, n_steps: int):
 def fmt_spread(timing, units):
     """'median (IQR q1-q3)' in ns per unit."""
     scale = 1e9 / units
-    return (f"{timing.median * scale:9.2f} ({timing.q1 * scale:7.2f}-{timing.q3 * scale:7.2f})")
+    return f"{timing.median * scale:9.2f} ({timing.q1 * scale:7.2f}-{timing.q3 * scale:7.2f})"
 
 
 def report_kernels(problem: Problem):

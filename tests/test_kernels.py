@@ -161,8 +161,10 @@ def test_displacement_integral_exact_for_the_elastic_field(S, k, n):
     sig[-1] = S
     U = np.sqrt(np.maximum((S - sig) * (S + sig), 0.0)) / k
     ratio, w_young, w_old = K.age_interval_weights(k, 0.0, 1.0, n, *FINE)
-    got = K.displacement_integral(sig[:1], U[:1], sig[1:], U[1:], n - 1, S, k, 0.0, 1.0,
-                                  ratio, w_young, w_old)
+    widths = np.array([0.0] + [K.interval_width(a, b) for a, b in zip(sig[:-1], sig[1:])])
+    # The first two nodes as "preloaded" (trapezoid), the rest as entered (age weights).
+    got = K.displacement_integral(sig[:1], U[:1], widths[:2], sig[1:], U[1:], widths[1:],
+                                  n - 1, S, ratio, w_young, w_old)
     b_minus_1 = S * S / (1.0 + math.sqrt(1.0 + S * S))
     assert got == pytest.approx(b_minus_1 / k, rel=1e-12)
 

@@ -245,21 +245,29 @@ def step_entered(sigma, U, n_born, step, s_old, s_new, k, decay, w_old, w_new):
 
 
 @njit(cache=True)
-def displacement_integral(sig_pre, U_pre, sig_born, U_born, n_born, S, k, c, t,
+def interval_width(sigma_a, sigma_b):
+    """``x_b - x_a`` for ``x = sqrt(1 + sigma^2)``, without cancellation for thin zones."""
+    return (sigma_b - sigma_a) * (sigma_b + sigma_a) / (
+        math.sqrt(1.0 + sigma_a * sigma_a) + math.sqrt(1.0 + sigma_b * sigma_b))
+
+
+@njit(cache=True)
+def displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, S,
                           ratio, w_young, w_old):
     """``int_1^b U(x) / sqrt(b^2 - x^2) dx`` over the free zone (units of ``delta``).
 
     The field is written ``U = sqrt(b^2 - x^2) v(x)``, so no quadrature node sits on the
     singular end point and the elastic limit (``v = 1/k``) is integrated exactly. Elements
-    loaded since ``t = 0`` (ascending ``sigma < s0``) use a trapezoid on ``v`` in ``x``; the
-    entered ones (the last at ``b``, age 0) use :func:`age_interval_weights` (``k > 0``).
+    loaded since ``t = 0`` (ascending ``sigma < s0``) and the oldest entered one use a
+    trapezoid on ``v`` in ``x``; the other entered ones (the last at ``b``, age 0) use
+    :func:`age_interval_weights`. ``dx_pre[i]`` is the width in ``x`` of the interval ending
+    at preloaded node ``i`` (``dx_pre[n_pre]``: the one ending at the oldest entered element),
+    ``dx_born[j]`` that ending at entered element ``j``: node positions never change, so the
+    widths are computed once, not every step.
     """
     total = 0.0
     n_pre = sig_pre.shape[0]
-    # Part 1: preloaded elements and the oldest entered one (the element at s0).
-    x_prev = 0.0
     v_prev = 0.0
-    sg_prev = 0.0
     for i in range(n_pre + 1):
         if i < n_pre:
             sg = sig_pre[i]
@@ -267,36 +275,27 @@ def displacement_integral(sig_pre, U_pre, sig_born, U_born, n_born, S, k, c, t,
         else:
             sg = sig_born[0]
             u = U_born[0]
-        x = math.sqrt(1.0 + sg * sg)
         if i == n_pre and n_born == 1:
             # The element at s0 is at b: k == 0 (b fixed, U/q the same everywhere) or t = 0.
-            v = v_prev if i > 0 else 0.0
+            v = v_prev
         else:
             v = u / math.sqrt((S - sg) * (S + sg))
         if i > 0:
-            total += 0.5 * (v + v_prev) * (sg - sg_prev) * (sg + sg_prev) / (x + x_prev)
-        x_prev = x
+            total += 0.5 * (v + v_prev) * dx_pre[i]
         v_prev = v
-        sg_prev = sg
-    if n_born < 2:
-        return total
-    # Part 2: entered elements, youngest (age 0) last; g = v / R(age) is smooth.
+    # Entered elements, youngest (age 0) last; g = v / R(age) is smooth.
     youngest = n_born - 1
     g_old = 0.0
     for j in range(n_born):
         age = youngest - j
-        sg = sig_born[j]
-        x = math.sqrt(1.0 + sg * sg)
         if j < youngest:
+            sg = sig_born[j]
             g = U_born[j] / math.sqrt((S - sg) * (S + sg)) / ratio[age]
         else:
             g = g_old  # R(0) = 0: take g from the element one step older
         if j > 0:
-            dx = (sg - sg_prev) * (sg + sg_prev) / (x + x_prev)
-            total += dx * (g * w_young[age] + g_old * w_old[age])
+            total += dx_born[j] * (g * w_young[age] + g_old * w_old[age])
         g_old = g
-        x_prev = x
-        sg_prev = sg
     return total
 
 
@@ -311,12 +310,13 @@ def gap_from_integral(h, S, integral):
 
 
 @njit(cache=True)
-def march(sig_pre, U_pre, sig_born, U_born, n_born, step, step_stop, k, c, h0, dt,
-          decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old,
+def march(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step, step_stop, k, c,
+          h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old,
           t_out, gap_out):
     """Advance the foundation from step ``step`` until the gap reaches 1 or ``step_stop``.
 
-    ``sig_born``/``U_born`` must have room for ``step_stop + 1`` elements; a new element is
+    ``sig_born``/``U_born``/``dx_born`` must have room for ``step_stop + 1`` elements (see
+    :func:`displacement_integral` for ``dx_pre``/``dx_born``); a new element is
     placed at ``b`` after every step (``sigma = s(t)``), so element entries always fall on step
     boundaries. ``t_out``/``gap_out`` receive the time and gap after each step, indexed by
     step number. Returns ``(step, n_born, crossed)``.
@@ -332,9 +332,10 @@ def march(sig_pre, U_pre, sig_born, U_born, n_born, step, step_stop, k, c, h0, d
         if k > 0.0:
             sig_born[n_born] = s_new
             U_born[n_born] = 0.0
+            dx_born[n_born] = interval_width(sig_born[n_born - 1], s_new)
             n_born += 1
-        integral = displacement_integral(sig_pre, U_pre, sig_born, U_born, n_born, s_new, k, c,
-                                         t_new, ratio, w_young, w_old)
+        integral = displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born,
+                                         n_born, s_new, ratio, w_young, w_old)
         g = gap_from_integral(h0 + t_new, s_new, integral)
         t_out[step] = t_new
         gap_out[step] = g

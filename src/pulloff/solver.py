@@ -195,7 +195,11 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     capacity = n_stop + 2
     sig_born = np.zeros(capacity)
     U_born = np.zeros(capacity)
+    dx_born = np.zeros(capacity)
     sig_born[0] = s0
+    nodes_pre = np.append(sig_pre, s0)
+    dx_pre = np.zeros(nodes_pre.size)
+    dx_pre[1:] = [kernels.interval_width(a, b) for a, b in zip(nodes_pre[:-1], nodes_pre[1:])]
     n_born = 1
     nodes, comps, weights = kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS
     decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
@@ -233,9 +237,9 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
         step_before = step
         try:
             step, n_born, crossed = kernels.march(
-                sig_pre, U_pre, sig_born, U_born, n_born, step, stop, k, c, h0, dt, decay,
-                w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old, t_out,
-                gap_out)
+                sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step, stop, k, c,
+                h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
+                w_old, t_out, gap_out)
         except KeyboardInterrupt:
             # Compiled code does not see signals; Python raises on return, before ``step``
             # is updated, so the arrays hold a consistent state up to ``step``.
