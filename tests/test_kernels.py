@@ -153,18 +153,27 @@ def test_entered_element_matches_ode_solution():
 
 
 @settings(max_examples=30, deadline=None)
-@given(S=st.floats(1e-6, 50.0), k=st.floats(1e-6, 1e3), n=st.integers(3, 40))
-def test_displacement_integral_exact_for_the_elastic_field(S, k, n):
+@given(S=st.floats(1e-6, 50.0), k=st.floats(1e-6, 1e3), n=st.integers(3, 40),
+       entered_share=st.floats(0.05, 1.0))
+def test_displacement_integral_exact_for_the_elastic_field(S, k, n, entered_share):
     """U = sqrt(S^2 - sigma^2)/k (elastic) integrates to (b - 1)/k on any mesh."""
-    sig = np.sort(S * np.random.default_rng(n).uniform(0, 1, n))
-    sig[0] = 0.0
-    sig[-1] = S
-    U = np.sqrt(np.maximum((S - sig) * (S + sig), 0.0)) / k
-    ratio, w_young, w_old = K.age_interval_weights(k, 0.0, 1.0, n, *FINE)
-    widths = np.array([0.0] + [K.interval_width(a, b) for a, b in zip(sig[:-1], sig[1:])])
-    # The first two nodes as "preloaded" (trapezoid), the rest as entered (age weights).
-    got = K.displacement_integral(sig[:1], U[:1], widths[:2], sig[1:], U[1:], widths[1:],
-                                  n - 1, S, ratio, w_young, w_old)
+    # Entered elements sit at step boundaries below S; preloaded ones anywhere below those.
+    n_born = max(2, int(entered_share * n))
+    s0 = S * (1.0 - entered_share)
+    k_dt = (S - s0) / (n_born - 1)
+    born = S - k_dt * np.arange(n_born - 1, -1, -1)
+    born[0], born[-1] = s0, S
+    pre = np.sort(s0 * np.random.default_rng(n).uniform(0, 1, n))[:-1] if s0 > 0 else born[:0]
+    if pre.size:
+        pre[0] = 0.0
+    offset = s0 - pre
+    nodes = np.concatenate([pre, born])
+    U = np.sqrt(np.maximum((S - nodes) * (S + nodes), 0.0)) / k
+    widths = np.array([0.0] + [K.interval_width(a, b) for a, b in zip(nodes[:-1], nodes[1:])])
+    ratio, w_young, w_old = K.age_interval_weights(k, 0.0, 1.0, n_born, *FINE)
+    got = K.displacement_integral(pre, offset, U[:pre.size], widths[:pre.size + 1], born,
+                                  U[pre.size:], widths[pre.size:], n_born, S, S - s0, k_dt,
+                                  ratio, w_young, w_old)
     b_minus_1 = S * S / (1.0 + math.sqrt(1.0 + S * S))
     assert got == pytest.approx(b_minus_1 / k, rel=1e-12)
 

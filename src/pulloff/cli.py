@@ -19,6 +19,7 @@ def _cmd_run(args) -> int:
         out = Path(scene.output.path)
     if out is None:
         out = Path("runs") / f"{scene.name or Path(args.config).stem}.h5"
+    _check_writable(out, "-o/output.path")
     result = solver.simulate(scene, progress=not args.quiet and sys.stderr.isatty())
     record = h5io.result_to_record(result, scene_mod.scene_to_yaml(scene))
     h5io.write(out, record)
@@ -38,6 +39,7 @@ def _cmd_sweep(args) -> int:
 
     scene = scene_mod.load_scene(args.config, overrides=args.set or ())
     axes = [sweep_mod.parse_axis(text) for text in args.vary]
+    _check_writable(Path(args.output), "-o")
     start = time.perf_counter()
     result = sweep_mod.sweep(scene, axes, out=args.output, workers=args.workers,
                              scheduler=args.scheduler, histories=args.histories,
@@ -45,6 +47,15 @@ def _cmd_sweep(args) -> int:
     print(report.format_sweep(result))
     print(f"  {time.perf_counter() - start:.1f} s; wrote {args.output}")
     return 0
+
+
+def _check_writable(path: Path, key: str) -> None:
+    """Fail before any work if the result could not be written."""
+    if path.is_dir():
+        raise ValueError(f"{key} = {path}: is a directory, not a file name")
+    parent = path.parent if str(path.parent) else Path(".")
+    if parent.exists() and not parent.is_dir():
+        raise ValueError(f"{key} = {path}: {parent} is not a directory")
 
 
 def _cmd_validate(args) -> int:
@@ -152,6 +163,10 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
+    except BrokenPipeError:
+        # `pulloff show FILE | head`: the reader left; that is not an error of ours.
+        sys.stderr.close()
+        return 0
     except (SceneError, ValueError, OSError) as exc:
         print(f"pulloff {args.command}: error: {exc}", file=sys.stderr)
         return 2
@@ -159,6 +174,10 @@ def main(argv=None) -> int:
         print(f"pulloff {args.command}: interrupted; no partial file written (a sweep keeps "
               f"its finished rows: run the same command to resume)", file=sys.stderr)
         return 130
+    except Exception as exc:  # a bug: say so in one line, with what to report
+        print(f"pulloff {args.command}: internal error: {type(exc).__name__}: {exc} "
+              f"(please report it with the scene file)", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

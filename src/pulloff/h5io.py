@@ -32,7 +32,7 @@ SUMMARY_UNITS = {
     "detached": "", "t_detach": "s", "h_detach": "m", "b_detach": "m", "zone_ratio_detach": "1",
     "F_contact_detach": "N", "F_total_detach": "N", "alpha": "1", "chi": "1", "V": "1",
     "n_elements": "1", "n_steps": "1", "wall_time": "s", "error_estimate": "1",
-    "t_end": "s", "history": "",
+    "t_end": "s", "history": "", "notes": "",
 }
 
 ANALYTIC_UNITS = {
@@ -60,6 +60,7 @@ def result_to_record(result, scene_yaml: str) -> dict:
         "error_estimate": result.error_estimate,
         "t_end": result.t_end,
         "history": result.history_model,
+        "notes": "; ".join(result.notes),
     }
     return {
         "scene": scene_yaml,
@@ -88,6 +89,10 @@ def atomic_file(path):
         with h5py.File(tmp_name, "w") as f:
             stamp(f)
             yield f
+        # mkstemp creates 0600; a result file gets the permissions of any new file here.
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp_name, 0o666 & ~umask)
         os.replace(tmp_name, path)
     except BaseException:
         Path(tmp_name).unlink(missing_ok=True)
@@ -176,7 +181,8 @@ def _attrs(group) -> dict:
 
 
 def load(path) -> dict:
-    """Read a run file into plain Python: the same shape as :func:`result_to_record` gives.
+    """Read a run file into plain Python: the keys of :func:`result_to_record`, plus
+    ``units``, ``created`` and ``software_version`` from the file.
 
     Raises ``ValueError`` naming the file if it is not a pulloff file of a known schema.
     """

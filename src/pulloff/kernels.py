@@ -221,12 +221,16 @@ def age_interval_weights(k, c, dt, n_ages, nodes, complements, weights):
 
 
 @njit(cache=True)
-def step_preloaded(sigma, U, s_old, s_new, decay, w_old, w_new):
-    """Advance the elements that were inside the zone at ``t = 0`` by one step (in place)."""
+def step_preloaded(sigma, offset, U, kt_old, kt_new, s_old, s_new, decay, w_old, w_new):
+    """Advance the elements that were inside the zone at ``t = 0`` by one step (in place).
+
+    ``offset = s0 - sigma`` (exact, from the mesh) and ``kt = k t``: ``s - sigma`` is formed as
+    their sum, never as a difference of two nearly equal ``s`` and ``sigma``.
+    """
     for i in range(sigma.shape[0]):
         sg = sigma[i]
-        q_old = math.sqrt(max((s_old - sg) * (s_old + sg), 0.0))
-        q_new = math.sqrt(max((s_new - sg) * (s_new + sg), 0.0))
+        q_old = math.sqrt((offset[i] + kt_old) * (s_old + sg))
+        q_new = math.sqrt((offset[i] + kt_new) * (s_new + sg))
         U[i] = decay * U[i] + w_old * q_old + w_new * q_new
 
 
@@ -252,8 +256,8 @@ def interval_width(sigma_a, sigma_b):
 
 
 @njit(cache=True)
-def displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, S,
-                          ratio, w_young, w_old):
+def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, dx_born,
+                          n_born, S, kt, k_dt, ratio, w_young, w_old):
     """``int_1^b U(x) / sqrt(b^2 - x^2) dx`` over the free zone (units of ``delta``).
 
     The field is written ``U = sqrt(b^2 - x^2) v(x)``, so no quadrature node sits on the
@@ -263,7 +267,8 @@ def displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_b
     :func:`age_interval_weights`. ``dx_pre[i]`` is the width in ``x`` of the interval ending
     at preloaded node ``i`` (``dx_pre[n_pre]``: the one ending at the oldest entered element),
     ``dx_born[j]`` that ending at entered element ``j``: node positions never change, so the
-    widths are computed once, not every step.
+    widths are computed once, not every step. ``S - sigma`` comes from exact offsets:
+    ``offset_pre + k t`` for preloaded elements, ``k dt age`` for entered ones (``kt``, ``k_dt``).
     """
     total = 0.0
     n_pre = sig_pre.shape[0]
@@ -272,14 +277,16 @@ def displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_b
         if i < n_pre:
             sg = sig_pre[i]
             u = U_pre[i]
+            ahead = offset_pre[i] + kt
         else:
             sg = sig_born[0]
             u = U_born[0]
+            ahead = kt
         if i == n_pre and n_born == 1:
             # The element at s0 is at b: k == 0 (b fixed, U/q the same everywhere) or t = 0.
             v = v_prev
         else:
-            v = u / math.sqrt((S - sg) * (S + sg))
+            v = u / math.sqrt(ahead * (S + sg))
         if i > 0:
             total += 0.5 * (v + v_prev) * dx_pre[i]
         v_prev = v
@@ -289,8 +296,7 @@ def displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_b
     for j in range(n_born):
         age = youngest - j
         if j < youngest:
-            sg = sig_born[j]
-            g = U_born[j] / math.sqrt((S - sg) * (S + sg)) / ratio[age]
+            g = U_born[j] / math.sqrt(k_dt * age * (S + sig_born[j])) / ratio[age]
         else:
             g = g_old  # R(0) = 0: take g from the element one step older
         if j > 0:
@@ -310,9 +316,9 @@ def gap_from_integral(h, S, integral):
 
 
 @njit(cache=True)
-def march(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step, step_stop, k, c,
-          h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old,
-          t_out, gap_out):
+def march(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step,
+          step_stop, k, c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio,
+          w_young, w_old, t_out, gap_out):
     """Advance the foundation from step ``step`` until the gap reaches 1 or ``step_stop``.
 
     ``sig_born``/``U_born``/``dx_born`` must have room for ``step_stop + 1`` elements (see
@@ -326,7 +332,8 @@ def march(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step, step_
         t_new = (step + 1) * dt
         s_old = k * (h0 + t_old) + c
         s_new = k * (h0 + t_new) + c
-        step_preloaded(sig_pre, U_pre, s_old, s_new, decay, w_pre_old, w_pre_new)
+        step_preloaded(sig_pre, offset_pre, U_pre, k * t_old, k * t_new, s_old, s_new, decay,
+                       w_pre_old, w_pre_new)
         step_entered(sig_born, U_born, n_born, step, s_old, s_new, k, decay, w_on_old, w_on_new)
         step += 1
         if k > 0.0:
@@ -334,8 +341,9 @@ def march(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step, step_
             U_born[n_born] = 0.0
             dx_born[n_born] = interval_width(sig_born[n_born - 1], s_new)
             n_born += 1
-        integral = displacement_integral(sig_pre, U_pre, dx_pre, sig_born, U_born, dx_born,
-                                         n_born, s_new, ratio, w_young, w_old)
+        integral = displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born,
+                                         dx_born, n_born, s_new, k * t_new, k * dt, ratio,
+                                         w_young, w_old)
         g = gap_from_integral(h0 + t_new, s_new, integral)
         t_out[step] = t_new
         gap_out[step] = g

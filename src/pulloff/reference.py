@@ -335,7 +335,10 @@ def reference_detachment(G, eta, sigma_c, delta, a, v, h0=0.0, rtol=1e-10, t_max
         return dict(detached=True, t_detach=T * delta / v, h_detach=delta * (sc.H0 + T),
                     b_detach=a * math.sqrt(1.0 + S * S), F_contact=Fc, F_total=Ft)
 
-    if sc.gap_upper(0.0) >= 1.0:  # U(0) = 0, so this is the exact gap(0)
+    # U(0) = 0 for eta > 0 (a damper cannot move instantly), so the gap with I = 0 is the
+    # exact gap(0); an elastic solid (eta = 0) carries U = q/(4G) at once: the frozen gap.
+    gap0 = sc.gap_frozen(0.0) if sc.c == 0.0 < sc.k else sc.gap_upper(0.0)
+    if gap0 >= 1.0:
         return result(0.0)
     if sc.k == 0.0 and sc.c == 0.0:
         return none

@@ -399,8 +399,6 @@ def group_values(alpha: float, chi: float, G: float = 1e6, sigma_c: float = 1e6,
     since ``alpha = chi / (4 V^2)`` with ``V = eta v / (sigma_c a)``,
     ``eta = sqrt(chi / (4 alpha)) sigma_c a / v`` (MODEL.md section 4).
     """
-    import math
-
     delta = chi * sigma_c * a / (math.pi * G)
     eta = math.sqrt(chi / (4.0 * alpha)) * sigma_c * a / v
     return {"eta": eta, "delta": delta}

@@ -327,10 +327,6 @@ def _execute_dask(base_yaml, overrides, todo, scheduler, histories, drops):
 
 # --- file ----------------------------------------------------------------------------------
 
-def _numeric(axis: Axis) -> bool:
-    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis.values)
-
-
 def _table(layout: _Layout, rows):
     indices = sorted(rows)
     table = {"index": np.asarray(indices, dtype=np.int64)}
