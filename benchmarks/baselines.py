@@ -25,7 +25,8 @@ import scipy.sparse
 from scipy.integrate import solve_ivp
 
 from pulloff import kernels
-from pulloff.solver import Problem, _crossing_time, frozen_detach_time
+from pulloff.solver import (Problem, _crossing_time, frozen_detach_time, preloaded_mesh,
+                            step_weights)
 
 
 # --------------------------------------------------------------------------------------------
@@ -44,10 +45,7 @@ def mol_mesh(problem: Problem, n_elements: int, t_ref: float) -> np.ndarray:
     s_max = problem.s_of(t_ref)
     n_pre = max(4, round(n_elements * s0 / s_max)) if s0 > 0.0 else 0
     n_entered = max(4, n_elements - n_pre)
-    angles = np.arange(n_pre, 0, -1) * (0.5 * np.pi / max(n_pre, 1))
-    preloaded = s0 * np.cos(angles)
-    if n_pre:
-        preloaded[0] = 0.0
+    preloaded, _ = preloaded_mesh(s0, n_pre)
     entered = s0 + (s_max - s0) * np.arange(n_entered + 1) / n_entered
     return np.concatenate([preloaded, entered])
 
@@ -137,13 +135,8 @@ def march_numpy(problem: Problem, dt: float, n_stop: int,
     s0 = problem.s_of(0.0)
     # Mesh of the elements loaded at t = 0: the rule of run_foundation, verbatim.
     s_ref = problem.s_of(n_stop * dt)
-    if s0 > 0.0:
-        n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
-        angles = np.arange(n_pre, 0, -1) * (0.5 * np.pi / n_pre)
-        sig_pre = s0 * np.cos(angles)
-        sig_pre[0] = 0.0
-    else:
-        sig_pre = np.zeros(0)
+    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
+    sig_pre, _ = preloaded_mesh(s0, n_pre)
     capacity = n_stop + 2
     # Entered element j sits at s(j dt): placed at b after step j (j = 0 is the one at s0).
     # Positions are known in advance, so their geometry is computed once, with the kernel's
@@ -163,12 +156,8 @@ def march_numpy(problem: Problem, dt: float, n_stop: int,
     U_1 = np.zeros(sig_1.size)
     U_pre = U_1[:-1]
 
-    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
-    w_on_old, w_on_new = kernels.onset_weights(k, c, dt, capacity, kernels.TS_NODES,
-                                               kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
-    ratio, w_young, w_old = kernels.age_interval_weights(
-        k, c, dt, capacity, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
-        kernels.TS_FINE_WEIGHTS)
+    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
+     w_old) = step_weights(k, c, dt, capacity)
     t_out = np.zeros(capacity)
     gap_out = np.zeros(capacity)
     gap_out[0] = kernels.gap_from_integral.py_func(h0, s0, 0.0)

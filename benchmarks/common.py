@@ -14,37 +14,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pulloff.scene import parse_scene
+from pulloff.scene import scene_from_groups
 
 
 # --------------------------------------------------------------------------------------------
-# Scenes (copied from tests/test_solver.py so the benchmarks do not import the tests).
+# Scenes
 
-def make_scene(G=3e5, eta=3e3, sigma_c=5e6, delta=1e-8, a=1e-3, v=1e-3, h0=0.0,
-               history="exact", rtol=1e-6, t_max=None, **output):
-    """A validated scene from SI values: G [Pa], eta [Pa s], sigma_c [Pa], delta, a, h0 [m],
-    v [m/s], t_max [s]."""
-    data = {
-        "schema": 1,
-        "geometry": {"kind": "flat_punch", "radius": a},
-        "material": {"kind": "kelvin_voigt", "G": G, "eta": eta},
-        "adhesion": {"kind": "dugdale", "sigma_c": sigma_c, "delta": delta},
-        "loading": {"kind": "constant_velocity", "v": v, "h0": h0},
-        "model": {"history": history},
-        "numerics": {"rtol": rtol, **({"t_max": t_max} if t_max is not None else {})},
-        "output": output,
-    }
-    return parse_scene(data)
-
-
-def scene_for_groups(alpha, chi, a=1e-3, G=1e6, sigma_c=1e6, **kw):
-    """SI values with the given alpha and chi (MODEL.md section 4)."""
-    delta = chi * sigma_c * a / (math.pi * G)
-    # alpha = chi / (4 V^2) with V = eta v / (sigma_c a); choose v = 1e-3 m/s.
-    V = math.sqrt(chi / (4.0 * alpha))
-    v = 1e-3
-    eta = V * sigma_c * a / v
-    return make_scene(G=G, eta=eta, sigma_c=sigma_c, delta=delta, a=a, v=v, **kw)
+def scene_for_groups(alpha, chi, **kw):
+    """A seed scene with the given alpha and chi (MODEL.md section 4), as the tests build it."""
+    return scene_from_groups(alpha, chi, **kw)
 
 
 # --------------------------------------------------------------------------------------------

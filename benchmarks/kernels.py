@@ -27,7 +27,8 @@ import numpy as np  # noqa: E402
 from common import loglog_slope, machine_summary, scene_for_groups, time_call  # noqa: E402
 from pulloff import kernels  # noqa: E402
 from pulloff.solver import (Problem, analytic_predictions, frozen_detach_time,  # noqa: E402
-                            run_foundation, simulate)
+                            preloaded_mesh, run_foundation, simulate,
+                            step_weights)
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SIZES = [100, 1_000, 10_000, 100_000]
@@ -56,15 +57,14 @@ def setup(problem: Problem, n: int):
     t_ref = frozen_detach_time(problem)
     dt = t_ref / n
     s0 = problem.s_of(0.0)
-    sig_pre = s0 * np.cos(np.arange(n, 0, -1) * (0.5 * np.pi / n))
-    sig_pre[0] = 0.0
+    sig_pre, offset_pre = preloaded_mesh(s0, n)
     steps = np.arange(n + 1)
     sig_born = k * (problem.h0_scaled + steps * dt) + c
     S = sig_born[-1] + k * dt
     U_pre = 0.5 * np.sqrt((S - sig_pre) * (S + sig_pre)) / k
     U_born = 0.5 * np.sqrt((S - sig_born) * (S + sig_born)) / k
-    return dict(k=k, c=c, dt=dt, S=S, sig_pre=sig_pre, U_pre=U_pre, sig_born=sig_born,
-                U_born=U_born)
+    return dict(k=k, c=c, dt=dt, S=S, sig_pre=sig_pre, offset_pre=offset_pre, U_pre=U_pre,
+                sig_born=sig_born, U_born=U_born)
 
 
 def kernel_calls(problem: Problem, n: int):
@@ -81,6 +81,8 @@ def kernel_calls(problem: Problem, n: int):
     # For the gap integral: half the elements preloaded, half entered (n in total).
     half = n // 2
     sig_p, U_p = a["sig_pre"][::2][:half], a["U_pre"][::2][:half]
+    off_p = a["offset_pre"][::2][:half]
+    t_now = (S - c) / k - problem.h0_scaled  # the time at which s = S
     nodes_p = np.append(sig_p, a["sig_born"][0])
     dx_p = np.append(0.0, [kernels.interval_width(x, y) for x, y in zip(nodes_p[:-1],
                                                                         nodes_p[1:])])
@@ -88,12 +90,13 @@ def kernel_calls(problem: Problem, n: int):
                                                                         a["sig_born"][1:])])
     return {
         "step_preloaded": (lambda: kernels.step_preloaded(
-            sig_pre, U_pre, S - k * dt, S, decay, w_old, w_new), n),
+            sig_pre, a["offset_pre"], U_pre, k * (t_now - dt), k * t_now, S - k * dt, S, decay,
+            w_old, w_new), n),
         "step_entered": (lambda: kernels.step_entered(
             sig_born, U_born, n, n - 1, S - k * dt, S, k, decay, w_on_old, w_on_new), n),
         "displacement_integral": (lambda: kernels.displacement_integral(
-            sig_p, U_p, dx_p, a["sig_born"], a["U_born"], dx_b, n - half, S, ratio, w_young,
-            w_aged), n),
+            sig_p, off_p, U_p, dx_p, a["sig_born"], a["U_born"], dx_b, n - half, S, k * t_now,
+            k * dt, ratio, w_young, w_aged), n),
         "onset_weights": (lambda: kernels.onset_weights(k, c, dt, n, *tables), n),
         "age_interval_weights": (lambda: kernels.age_interval_weights(k, c, dt, n, *fine), n),
     }
@@ -109,18 +112,13 @@ def march_call(problem: Problem, n_steps: int):
     dt = 0.5 * t_ref / n_steps
     s0 = problem.s_of(0.0)
     n_pre = max(8, int(math.ceil(n_steps * s0 / problem.s_of(n_steps * dt))))
-    sig_pre0 = s0 * np.cos(np.arange(n_pre, 0, -1) * (0.5 * np.pi / n_pre))
-    sig_pre0[0] = 0.0
+    sig_pre0, offset_pre0 = preloaded_mesh(s0, n_pre)
     nodes = np.append(sig_pre0, s0)
     dx_pre = np.append(0.0, [kernels.interval_width(x, y) for x, y in zip(nodes[:-1],
                                                                           nodes[1:])])
     capacity = n_steps + 2
-    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
-    w_on_old, w_on_new = kernels.onset_weights(k, c, dt, capacity, kernels.TS_NODES,
-                                               kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
-    ratio, w_young, w_old = kernels.age_interval_weights(
-        k, c, dt, capacity, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
-        kernels.TS_FINE_WEIGHTS)
+    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
+     w_old) = step_weights(k, c, dt, capacity)
 
     def call():
         # Fresh state per call: march advances U and places elements in place.
@@ -132,9 +130,9 @@ def march_call(problem: Problem, n_steps: int):
         t_out = np.zeros(capacity)
         gap_out = np.zeros(capacity)
         step, n_born, crossed = kernels.march(
-            sig_pre0, U_pre, dx_pre, sig_born, U_born, dx_born, 1, 0, n_steps, k, c, h0, dt,
-            decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old, t_out,
-            gap_out)
+            sig_pre0, offset_pre0, U_pre, dx_pre, sig_born, U_born, dx_born, 1, 0, n_steps, k,
+            c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old,
+            t_out, gap_out)
         assert step == n_steps and not crossed
         return n_born
 
@@ -222,13 +220,13 @@ def report_march(problem: Problem):
     p_top = loglog_slope(steps[-3:], times[-3:])
     out(f"  exponent of time vs element-steps: {p_work:.3f} ({exponent_comment(p_work, 1.0)});"
         f" vs steps: {p_steps:.3f} over all, {p_top:.3f} over the last three")
-    # Cost of one numba dispatch of march with its 23 arguments (a call that does no step).
+    # Cost of one numba dispatch of march with its 24 arguments (a call that does no step).
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     z = np.zeros(4)
 
     def no_step():
-        return kernels.march(z, z, z, z, z, z, 1, 0, 0, k, c, h0, 1.0, 0.0, 0.0, 0.0, z, z, z, z,
-                             z, z, z)
+        return kernels.march(z, z, z, z, z, z, z, 1, 0, 0, k, c, h0, 1.0, 0.0, 0.0, 0.0, z, z, z,
+                             z, z, z, z)
 
     no_step()
     timing, _ = time_call(no_step, min_repeats=MIN_REPEATS, min_total=MIN_TOTAL)

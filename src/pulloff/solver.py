@@ -172,6 +172,38 @@ def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
     return t_lin
 
 
+def preloaded_mesh(s0: float, n: int):
+    """Nodes ``sigma`` (ascending, from 0) of the zone loaded at ``t = 0`` and ``s0 - sigma``.
+
+    Uniform in angle, ``sigma = s0 cos(theta)``: they cluster toward ``b(0)``, where the load
+    of an element is weakest and varies fastest. The offsets ``s0 - sigma`` are exact, so the
+    kernels never subtract two nearly equal ``s`` and ``sigma``. No nodes when ``s0 = 0``.
+    """
+    if s0 <= 0.0:
+        return np.zeros(0), np.zeros(0)
+    angles = np.arange(n, 0, -1) * (0.5 * np.pi / n)
+    sigma = s0 * np.cos(angles)
+    sigma[0] = 0.0
+    return sigma, 2.0 * s0 * np.sin(0.5 * angles) ** 2
+
+
+def step_weights(k: float, c: float, dt: float, n_ages: int):
+    """All weights of one step size: ``(decay, w_pre_old, w_pre_new, w_on_old, w_on_new,
+    ratio, w_young, w_old)`` for :func:`pulloff.kernels.march`, for element ages up to
+    ``n_ages`` steps (tables of zeros when ``k = 0``: no element ever enters)."""
+    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
+    if k > 0.0:
+        w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_ages, kernels.TS_NODES,
+                                                   kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
+        ratio, w_young, w_old = kernels.age_interval_weights(
+            k, c, dt, n_ages, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
+            kernels.TS_FINE_WEIGHTS)
+    else:
+        w_on_old = w_on_new = np.zeros(n_ages)
+        ratio = w_young = w_old = np.zeros(n_ages + 1)
+    return decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old
+
+
 def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
                    progress=None, n_preloaded: int | None = None) -> FoundationRun:
     """Step the foundation with step ``dt`` until detachment or ``n_stop`` steps.
@@ -182,18 +214,11 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     """
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     s0 = problem.s_of(0.0)
-    # Elements already inside the zone at t = 0 cluster toward b(0) (uniform in angle), where
-    # their load is weakest and varies fastest; one per step-spacing of the entering elements.
+    # Elements already inside the zone at t = 0: as many as entering elements would fill the
+    # same range of sigma.
     s_ref = problem.s_of(n_stop * dt)
-    if s0 > 0.0:
-        n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
-        angles = np.arange(n_pre, 0, -1) * (0.5 * np.pi / n_pre)
-        sig_pre = s0 * np.cos(angles)
-        sig_pre[0] = 0.0
-        # s0 - sigma, exact: the kernels never subtract two nearly equal s and sigma.
-        offset_pre = 2.0 * s0 * np.sin(0.5 * angles) ** 2
-    else:
-        sig_pre = offset_pre = np.zeros(0)
+    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
+    sig_pre, offset_pre = preloaded_mesh(s0, n_pre)
     if c == 0.0:
         # An elastic element follows its load at once, also the step lift h0 at t = 0.
         U_pre = np.sqrt(offset_pre * (s0 + sig_pre)) / k
@@ -208,16 +233,8 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     dx_pre = np.zeros(nodes_pre.size)
     dx_pre[1:] = [kernels.interval_width(a, b) for a, b in zip(nodes_pre[:-1], nodes_pre[1:])]
     n_born = 1
-    nodes, comps, weights = kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS
-    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
-    if k > 0.0:
-        w_on_old, w_on_new = kernels.onset_weights(k, c, dt, capacity, nodes, comps, weights)
-        ratio, w_young, w_old = kernels.age_interval_weights(
-            k, c, dt, capacity, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
-            kernels.TS_FINE_WEIGHTS)
-    else:
-        w_on_old = w_on_new = np.zeros(capacity)
-        ratio = w_young = w_old = np.zeros(capacity + 1)
+    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
+     w_old) = step_weights(k, c, dt, capacity)
     t_out = np.zeros(capacity)
     gap_out = np.zeros(capacity)
     gap_out[0] = frozen_gap(problem, 0.0)  # the frozen and exact states agree at t = 0
