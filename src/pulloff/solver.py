@@ -230,8 +230,11 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     dx_born = np.zeros(capacity)
     sig_born[0] = s0
     nodes_pre = np.append(sig_pre, s0)
+    x_pre = np.sqrt(1.0 + nodes_pre * nodes_pre)
+    # kernels.interval_width, vectorised: x widths without cancellation for thin zones.
     dx_pre = np.zeros(nodes_pre.size)
-    dx_pre[1:] = [kernels.interval_width(a, b) for a, b in zip(nodes_pre[:-1], nodes_pre[1:])]
+    dx_pre[1:] = (np.diff(nodes_pre) * (nodes_pre[1:] + nodes_pre[:-1])
+                  / (x_pre[1:] + x_pre[:-1]))
     n_born = 1
     (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
      w_old) = step_weights(k, c, dt, capacity)
