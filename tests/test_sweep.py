@@ -140,6 +140,8 @@ def test_cli_sweep_and_show(tmp_path, capsys):
     assert "3 rows, 0 failed" in printed and "loading.v" in printed
     assert main(["show", str(out)]) == 0
     assert "3 rows, 0 failed" in capsys.readouterr().out
+    assert main(["plot", str(out), "-o", str(tmp_path / "sweep.png")]) == 0
+    assert (tmp_path / "sweep.png").stat().st_size > 20_000
     assert main(["sweep", str(SEED), "--vary", "loading.speed=1,2", "-o",
                  str(tmp_path / "bad.h5")]) == 2
     assert "loading.speed" in capsys.readouterr().err

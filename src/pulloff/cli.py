@@ -93,12 +93,13 @@ def _is_sweep(path) -> bool:
 def _cmd_plot(args) -> int:
     from . import h5io, plots
 
-    if _is_sweep(args.file):
-        raise ValueError(f"{args.file}: a sweep file; plot its table with pulloff.sweeps."
-                         f"load_sweep, or see pulloff validate")
-    record = h5io.load(args.file)
     png = Path(args.output) if args.output else Path(args.file).with_suffix(".png")
-    plots.plot_history(record, png, title=str(args.file))
+    if _is_sweep(args.file):
+        from .sweeps import load_sweep
+
+        plots.plot_sweep(load_sweep(args.file), png, title=str(args.file))
+    else:
+        plots.plot_history(h5io.load(args.file), png, title=str(args.file))
     print(f"wrote {png}")
     return 0
 
@@ -150,7 +151,8 @@ def build_parser() -> argparse.ArgumentParser:
     show.add_argument("file")
     show.set_defaults(func=_cmd_show)
 
-    plot = sub.add_parser("plot", help="redraw the figure of a result file")
+    plot = sub.add_parser("plot", help="redraw the figure of a run file, or draw a sweep's "
+                                        "force against its first numeric axis")
     plot.add_argument("file")
     plot.add_argument("-o", "--output", help="PNG to write (default: next to the file)")
     plot.set_defaults(func=_cmd_plot)

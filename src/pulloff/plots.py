@@ -188,3 +188,46 @@ def _save(fig, path) -> Path:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def plot_sweep(result, path, title: str | None = None) -> Path:
+    """Pull-off force against the first numeric axis of a sweep, one line per value of the
+    other axes (at most eight), simulation solid and the seed's closed form dashed."""
+    import numpy as np
+
+    t = result.table
+    keys = [axis["key"] for axis in result.axes]
+    numeric = [k for k in keys if t[k].dtype.kind == "f"]
+    if not numeric:
+        raise ValueError("a sweep needs a numeric axis to be plotted")
+    x_key = numeric[0]
+    others = [k for k in keys if k != x_key]
+    groups = {}
+    for r in range(t["index"].size):
+        groups.setdefault(tuple(t[k][r] for k in others), []).append(r)
+    fig, ax = plt.subplots(figsize=(7.0, 4.8), constrained_layout=True)
+    for i, (label, rows) in enumerate(list(groups.items())[:8]):
+        rows = np.asarray(rows)[np.argsort(t[x_key][rows])]
+        name = ", ".join(f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}"
+                         for k, v in zip(others, label)) or "simulation"
+        ok = t["status"][rows] == "ok"
+        ax.plot(t[x_key][rows][ok], t["F_contact"][rows][ok], "o-", ms=3.5, color=f"C{i}",
+                label=name)
+        ax.plot(t[x_key][rows][ok], t["seed_closed_form_F"][rows][ok], "--", lw=1.0,
+                color=f"C{i}")
+    x = t[x_key][t["status"] == "ok"]
+    if x.size and np.all(x > 0) and x.max() / x.min() > 20:
+        ax.set_xscale("log")
+    positive = t["F_contact"][t["status"] == "ok"]
+    if positive.size and np.all(positive > 0) and positive.max() / positive.min() > 20:
+        ax.set_yscale("log")
+    ax.plot([], [], "k--", lw=1.0, label="seed closed form (eqs. 64/89)")
+    from .sweeps import SCENE_UNITS
+
+    ax.set_xlabel(f"{x_key} [{SCENE_UNITS.get(x_key, '-')}]")
+    ax.set_ylabel("F_contact at detachment [N]")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return _save(fig, path)
