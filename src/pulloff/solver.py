@@ -95,22 +95,27 @@ class Problem:
 # --------------------------------------------------------------------------------------------
 # Frozen history (the seed's eq. 31): closed form, nothing to discretise.
 
-def frozen_gap(problem: Problem, t: float) -> float:
+def frozen_memory(problem: Problem, t):
+    """``U / q`` of the frozen-load model at dimensionless time ``t``: ``(1 - exp(-k t/c)) / k``
+    with its exact limits ``1/k`` (``c = 0``) and ``t/c`` (``k = 0``); scalars or arrays."""
+    k, c = problem.k, problem.c
+    t = np.asarray(t, dtype=float)
+    if c == 0.0:
+        return np.full_like(t, 1.0 / k)
+    if k == 0.0:
+        return t / c
+    return -np.expm1(-k * t / c) / k
+
+
+def frozen_gap(problem: Problem, t):
     """Dimensionless gap of the seed's frozen-load model, without linearisation in ``b - a``.
 
-    Every element carries the current load since ``t = 0``:
-    ``U = q (1 - exp(-k t / c)) / k``, so ``int U / sqrt(b^2 - x^2) dx = (b - 1) (1 - e) / k``.
+    Every element carries the current load since ``t = 0``: ``U = q`` :func:`frozen_memory`,
+    so ``int U / sqrt(b^2 - x^2) dx = (b - 1)`` times that factor. Scalars or arrays.
     """
-    k, c = problem.k, problem.c
-    s = problem.s_of(t)
-    b_minus_1 = _zone_ratio(s)
-    if c == 0.0:
-        memory = 1.0 / k
-    elif k == 0.0:
-        memory = t / c
-    else:
-        memory = -math.expm1(-k * t / c) / k
-    return (2.0 / math.pi) * ((problem.h0_scaled + t) * math.atan(s) - b_minus_1 * memory)
+    s = problem.s_of(np.asarray(t, dtype=float))
+    return (2.0 / math.pi) * ((problem.h0_scaled + t) * np.arctan(s)
+                              - _zone_ratio(s) * frozen_memory(problem, t))
 
 
 def frozen_detach_time(problem: Problem, t_limit: float = math.inf) -> float:
@@ -127,8 +132,8 @@ def frozen_detach_time(problem: Problem, t_limit: float = math.inf) -> float:
             return math.inf
         hi *= 2.0
     lo = hi / 2.0 if hi > 1.0 else 0.0
-    return brentq(lambda t: frozen_gap(problem, t) - 1.0, lo, hi, xtol=1e-300, rtol=1e-15,
-                  maxiter=400)
+    return brentq(lambda t: float(frozen_gap(problem, t)) - 1.0, lo, hi, xtol=1e-300,
+                  rtol=1e-15, maxiter=400)
 
 
 # --------------------------------------------------------------------------------------------
@@ -384,7 +389,7 @@ def simulate(scene, progress: bool = False) -> Result:
 def _frozen_run(problem, t_frozen, t_limit, rows, snapshot_times):
     t_end = min(t_frozen, t_limit)
     t = np.linspace(0.0, t_end, max(2, rows)) if t_end > 0 else np.zeros(1)
-    gap = np.array([frozen_gap(problem, ti) for ti in t])
+    gap = frozen_gap(problem, t)
     detached = t_frozen <= t_limit
     snapshots = []
     for ts in snapshot_times:
@@ -392,13 +397,7 @@ def _frozen_run(problem, t_frozen, t_limit, rows, snapshot_times):
             s = problem.s_of(ts)
             sig = s * np.cos(np.linspace(0.5 * np.pi, 0.0, 65))
             q = np.sqrt(np.maximum((s - sig) * (s + sig), 0.0))
-            if problem.c == 0.0:
-                U = q / problem.k
-            elif problem.k == 0.0:
-                U = q * ts / problem.c
-            else:
-                U = -q * math.expm1(-problem.k * ts / problem.c) / problem.k
-            snapshots.append((ts, sig, U))
+            snapshots.append((ts, sig, q * frozen_memory(problem, ts)))
     run = FoundationRun(math.nan, t, gap, t_frozen if detached else math.nan, 0, 0, snapshots)
     # The root is found to rounding; the estimate is that of brentq's tolerance.
     return run, 4e-16 * 8
@@ -539,7 +538,7 @@ def _assemble(scene, problem: Problem, run: FoundationRun, error_estimate: float
 
 def _zone_ratio(s):
     """``(b - a)/a = sqrt(1 + s^2) - 1`` without cancellation for thin zones."""
-    return s * s / (1.0 + math.sqrt(1.0 + s * s))
+    return s * s / (1.0 + np.sqrt(1.0 + s * s))
 
 
 def analytic_predictions(problem: Problem) -> dict:
