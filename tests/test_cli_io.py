@@ -61,7 +61,7 @@ def test_failed_write_leaves_no_file_and_keeps_the_old_one(tmp_path, seed_record
         f.create_group("history")
         raise KeyboardInterrupt  # what Ctrl-C looks like mid-write
 
-    monkeypatch.setattr(h5io, "_fill", explode)
+    monkeypatch.setattr(h5io, "fill", explode)
     with pytest.raises(KeyboardInterrupt):
         h5io.write(path, record)
     assert path.read_bytes() == before
@@ -139,17 +139,16 @@ def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypa
     from pulloff import solver
 
     real = solver.kernels.march
-    calls = []
 
     def march_then_interrupt(*args):
-        calls.append(1)
-        if len(calls) == 60:  # well inside the finest level
+        step = args[11]
+        if step > 0:  # the second chunk of a level: the first one's rows are in the history
             raise KeyboardInterrupt
         return real(*args)
 
     monkeypatch.setattr(solver.kernels, "march", march_then_interrupt)
     out = tmp_path / "cut.h5"
-    assert main(["run", str(SEED), "-o", str(out), "-q"]) == 130
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--set", "numerics.rtol=1e-9"]) == 130
     assert "complete = False" in capsys.readouterr().err
     rec = h5io.load(out)
     assert rec["complete"] is False

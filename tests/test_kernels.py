@@ -132,12 +132,14 @@ def test_entered_element_matches_ode_solution():
     sigma = k * (h0 + 0.0) + c  # enters at t = 0
     decay, _, _ = K.linear_load_weights(k, c, dt)
     w_old, w_new = K.onset_weights(k, c, dt, n + 1, *RULE)
+    moments = K.onset_moments(k, c, dt, *RULE)
     sig = np.array([sigma])
     U = np.zeros(1)
     for step in range(n):
         s_old = k * (h0 + step * dt) + c
         s_new = k * (h0 + (step + 1) * dt) + c
-        K.step_entered(sig, U, 1, step, s_old, s_new, k, decay, w_old, w_new)
+        K.step_entered(np.zeros(1, dtype=np.int64), sig, U, 1, step, s_old, s_new, k, decay,
+                       w_old, w_new, *moments)
 
     def load(t):
         s = k * (h0 + t) + c
@@ -171,11 +173,108 @@ def test_displacement_integral_exact_for_the_elastic_field(S, k, n, entered_shar
     U = np.sqrt(np.maximum((S - nodes) * (S + nodes), 0.0)) / k
     widths = np.array([0.0] + [K.interval_width(a, b) for a, b in zip(nodes[:-1], nodes[1:])])
     ratio, w_young, w_old = K.age_interval_weights(k, 0.0, 1.0, n_born, *FINE)
-    got = K.displacement_integral(pre, offset, U[:pre.size], widths[:pre.size + 1], born,
-                                  U[pre.size:], widths[pre.size:], n_born, S, S - s0, k_dt,
-                                  ratio, w_young, w_old)
+    steps = np.arange(n_born, dtype=np.int64)
+    got = K.displacement_integral(pre, offset, U[:pre.size], widths[:pre.size + 1],
+                                  np.zeros((1, 4)), steps, born, U[pre.size:], widths[pre.size:],
+                                  np.zeros((1, 4)), n_born, n_born - 1, S, S - s0, k_dt, ratio,
+                                  w_young, w_old)
     b_minus_1 = S * S / (1.0 + math.sqrt(1.0 + S * S))
     assert got == pytest.approx(b_minus_1 / k, rel=1e-12)
+    # Thinned (and with tables shorter than the oldest age), the trapezoid on v = 1/k that
+    # replaces the product weights is exact too.
+    sig_e, U_e, dx_e = born.copy(), U[pre.size:].copy(), widths[pre.size:].copy()
+    thin_w = np.zeros((n_born, 4))
+    kept = K.thin_entered(steps, sig_e, U_e, dx_e, thin_w, n_born, n_born - 1, 2, 1.5)
+    pre_w = (K.preloaded_cubic_weights(widths[:pre.size + 1]) if pre.size >= 3
+             else np.zeros((1, 4)))
+    got = K.displacement_integral(pre, offset, U[:pre.size], widths[:pre.size + 1], pre_w,
+                                  steps, sig_e, U_e, dx_e, thin_w, kept, n_born - 1, S, S - s0,
+                                  k_dt, ratio[:3], w_young[:2], w_old[:2])
+    assert got == pytest.approx(b_minus_1 / k, rel=1e-12)
+
+
+@pytest.mark.parametrize("k,c,dt", [(0.9, 0.4, 0.05), (1e-3, 2.0, 1e-4), (50.0, 1e-6, 0.3),
+                                    (2.0, 0.0, 0.01), (1e-8, 1e-9, 1e3)])
+def test_onset_weights_expansion_matches_the_tables(k, c, dt):
+    """Beyond the tables, the 1/age expansion gives the tabulated weights to rounding."""
+    n = 3000
+    w_old, w_new = K.onset_weights(k, c, dt, n, *RULE)
+    moments = K.onset_moments(k, c, dt, *RULE)
+    short_old, short_new = w_old[:K.ONSET_ASYMPTOTIC_AGE], w_new[:K.ONSET_ASYMPTOTIC_AGE]
+    for age in [K.ONSET_ASYMPTOTIC_AGE, 65, 100, 999, 2999]:
+        wo, wn = K.onset_weight_pair(age, short_old, short_new, *moments)
+        assert wo == pytest.approx(w_old[age], rel=1e-13, abs=1e-300)
+        assert wn == pytest.approx(w_new[age], rel=1e-13)
+        # Inside the tables they are read, not expanded.
+        assert K.onset_weight_pair(age, w_old, w_new, *moments) == (w_old[age], w_new[age])
+
+
+def test_thin_entered_keeps_young_and_oldest_and_grades_the_rest():
+    n, step, keep_young, ratio_max = 5000, 4999, 100, 1.05
+    born = np.arange(n, dtype=np.int64)
+    sigma = 0.3 + 1e-3 * born
+    U = np.sin(born.astype(float))
+    dx = np.zeros(n)
+    thin_w = np.zeros((n, 4))
+    kept = K.thin_entered(born, sigma, U, dx, thin_w, n, step, keep_young, ratio_max)
+    ages = step - born[:kept]
+    assert born[0] == 0 and ages[-1] == 0
+    assert np.all(np.diff(born[:kept]) > 0)
+    # Every element younger than keep_young survives, with its state.
+    young = ages < keep_young
+    assert young.sum() == keep_young
+    assert np.array_equal(U[:kept], np.sin(born[:kept].astype(float)))
+    # Gaps grow at most geometrically: older kept age <= ratio_max * younger (or adjacent).
+    older, younger = ages[:-1], ages[1:]
+    assert np.all((older <= ratio_max * younger) | (older - younger == 1) | (younger == 0)
+                  | (older == ages[0]))
+    # Geometric grading: about log(oldest/keep_young)/log(ratio_max) old elements remain.
+    expected = math.log(step / keep_young) / math.log(ratio_max)
+    assert expected / 2 < (kept - keep_young) < 2 * expected + 2
+    widths = [K.interval_width(a, b) for a, b in zip(sigma[:kept - 1], sigma[1:kept])]
+    assert np.allclose(dx[1:kept], widths, rtol=1e-15)
+    # The cubic weights of the thinned intervals integrate cubics exactly (quadratic first).
+    x = np.concatenate([[0.0], np.cumsum(dx[1:kept])])
+    for j in range(1, kept - 1):
+        if born[j] - born[j - 1] > 1:
+            for poly in ([1.0], [0.3, -2.0], [0.1, 0.5, -1.0], [2.0, 0.0, 0.0, 1.5][: 4 if j > 1 else 3]):
+                f = np.polynomial.Polynomial(poly)
+                exact = f.integ()(x[j]) - f.integ()(x[j - 1])
+                nodes = f(x[max(j - 2, 0):j + 2]) if j > 1 else np.concatenate([[0.0], f(x[0:3])])
+                assert thin_w[j] @ nodes == pytest.approx(exact, rel=1e-9, abs=1e-12 * abs(f(x[j])))
+
+
+def test_cubic_interval_weights_integrate_cubics():
+    out = np.zeros(4)
+    K.cubic_interval_weights(0.3, 0.5, 0.9, out)
+    nodes = np.array([-0.3, 0.0, 0.5, 1.4])
+    f = np.polynomial.Polynomial([0.2, -1.0, 0.7, 3.0])
+    assert out @ f(nodes) == pytest.approx(f.integ()(0.5) - f.integ()(0.0), rel=1e-14)
+    K.cubic_interval_weights(0.0, 0.5, 0.9, out)
+    assert out[0] == 0.0
+    g = np.polynomial.Polynomial([0.2, -1.0, 0.7])
+    assert out @ g(nodes) == pytest.approx(g.integ()(0.5) - g.integ()(0.0), rel=1e-14)
+    K.cubic_interval_weights(0.3, 0.5, 0.0, out)
+    assert out[3] == 0.0
+    assert out @ g(nodes) == pytest.approx(g.integ()(0.5) - g.integ()(0.0), rel=1e-14)
+
+
+def test_preloaded_cubic_weights_integrate_a_smooth_field():
+    """On a cosine-graded mesh, the cubic rule converges at fourth order (trapezoid: second)."""
+    def error(n):
+        theta = np.linspace(0.5 * np.pi, 0.0, n + 1)
+        x = 1.0 + np.cos(theta)
+        widths = np.concatenate([[0.0], np.diff(x)])
+        w = K.preloaded_cubic_weights(widths)
+        f = np.exp(x) * np.sin(3 * x)
+        got = sum(w[i, 0] * f[i - 2] * (i >= 2) + w[i, 1] * f[i - 1] + w[i, 2] * f[i]
+                  + (w[i, 3] * f[i + 1] if i + 1 <= n else 0.0) for i in range(1, n + 1))
+        # int e^y sin(3y) dy = e^y (sin 3y - 3 cos 3y) / 10
+        prim = lambda y: math.exp(y) * (math.sin(3 * y) - 3 * math.cos(3 * y)) / 10  # noqa: E731
+        exact = prim(2.0) - prim(1.0)
+        return abs(got - exact)
+    order = math.log2(error(40) / error(80))
+    assert 3.7 < order < 4.6
 
 
 def test_gap_from_integral_matches_definition():

@@ -20,9 +20,15 @@ def _cmd_run(args) -> int:
     if out is None:
         out = Path("runs") / f"{scene.name or Path(args.config).stem}.h5"
     _check_writable(out, "-o/output.path")
-    result = solver.simulate(scene, progress=not args.quiet and sys.stderr.isatty())
-    record = h5io.result_to_record(result, scene_mod.scene_to_yaml(scene))
-    h5io.write(out, record)
+    with h5io.atomic_file(out) as f:
+        # A fixed-step run streams its history into the file while it runs.
+        stream = h5io.HistoryStream(f) if scene.numerics.steps is not None else None
+        result = solver.simulate(scene, progress=not args.quiet and sys.stderr.isatty(),
+                                 stream=stream)
+        record = h5io.result_to_record(result, scene_mod.scene_to_yaml(scene))
+        h5io.fill(f, record, history_streamed=result.history_streamed)
+        if stream is not None:
+            record["history_rows_in_file"] = stream.rows
     png = out.with_suffix(".png")
     plots.plot_history(record, png, title=scene.name or Path(args.config).stem)
     print(report.format_table(record, title=f"{scene.name or args.config}"))
@@ -68,6 +74,10 @@ def _cmd_validate(args) -> int:
     return 0
 
 
+#: History rows read to show or draw a run; a streamed history may hold millions.
+_SHOWN_ROWS = 100_000
+
+
 def _cmd_show(args) -> int:
     from . import h5io, report
 
@@ -76,7 +86,7 @@ def _cmd_show(args) -> int:
 
         print(report.format_sweep(load_sweep(args.file)))
         return 0
-    record = h5io.load(args.file)
+    record = h5io.load(args.file, history_rows=_SHOWN_ROWS)
     print(report.format_table(record, title=str(args.file)))
     if not record["complete"]:
         print("  (file marked incomplete)")
@@ -99,7 +109,8 @@ def _cmd_plot(args) -> int:
 
         plots.plot_sweep(load_sweep(args.file), png, title=str(args.file))
     else:
-        plots.plot_history(h5io.load(args.file), png, title=str(args.file))
+        plots.plot_history(h5io.load(args.file, history_rows=_SHOWN_ROWS), png,
+                           title=str(args.file))
     print(f"wrote {png}")
     return 0
 

@@ -127,23 +127,61 @@ def open_for_reading(path) -> h5py.File:
 def write(path, record: dict) -> Path:
     """Write a run ``record`` (see :func:`result_to_record`) atomically to ``path``."""
     with atomic_file(path) as f:
-        _fill(f, record)
+        fill(f, record)
     return Path(path)
 
 
-def _fill(f: h5py.File, record: dict) -> None:
+class HistoryStream:
+    """Appends history rows to ``history/`` of an open file as a run produces them.
+
+    Called with a dict of SI columns (the names of ``HISTORY_UNITS``); the datasets are
+    chunked and grow, so a run of any length writes its history with O(chunk) memory.
+    :func:`fill` then adds the rest of the run and the dimension scale.
+    """
+
+    CHUNK_ROWS = 1 << 15
+
+    def __init__(self, f: h5py.File):
+        self.group = f.create_group("history")
+        for name, unit in HISTORY_UNITS.items():
+            ds = self.group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=float,
+                                           chunks=(self.CHUNK_ROWS,))
+            ds.attrs["unit"] = unit
+        self.rows = 0
+
+    def __call__(self, columns: dict) -> None:
+        n = len(columns["t"])
+        for name in HISTORY_UNITS:
+            ds = self.group[name]
+            ds.resize((self.rows + n,))
+            ds[self.rows:] = np.asarray(columns[name], dtype=float)
+        self.rows += n
+
+
+def fill(f: h5py.File, record: dict, history_streamed: bool = False) -> None:
+    """Write a run ``record`` into an open file; with ``history_streamed`` the history rows
+    are already in ``history/`` (see :class:`HistoryStream`) and ``record["history"]``,
+    a preview, is not written."""
     f.attrs["scene"] = record["scene"]
     f.attrs["complete"] = bool(record.get("complete", True))
 
-    hist = f.create_group("history")
-    axis = hist.create_dataset("t", data=np.asarray(record["history"]["t"], dtype=float))
-    axis.attrs["unit"] = HISTORY_UNITS["t"]
+    if history_streamed:
+        hist = f["history"]
+        axis = hist["t"]
+    else:
+        hist = f.create_group("history")
+        axis = hist.create_dataset("t", data=np.asarray(record["history"]["t"], dtype=float))
+        axis.attrs["unit"] = HISTORY_UNITS["t"]
     axis.make_scale("t")
     for name, unit in HISTORY_UNITS.items():
         if name == "t":
             continue
-        ds = hist.create_dataset(name, data=np.asarray(record["history"][name], dtype=float))
-        ds.attrs["unit"] = unit
+        if history_streamed:
+            ds = hist[name]
+        else:
+            ds = hist.create_dataset(name, data=np.asarray(record["history"][name],
+                                                           dtype=float))
+            ds.attrs["unit"] = unit
         ds.dims[0].attach_scale(axis)
 
     summary = f.create_group("summary")
@@ -180,9 +218,21 @@ def _attrs(group) -> dict:
     return out
 
 
-def load(path) -> dict:
+def _read_rows(ds, history_rows):
+    """A dataset, or every n-th row of it plus the last when it is longer than asked."""
+    n = ds.shape[0]
+    if history_rows is None or n <= history_rows:
+        return ds[()]
+    stride = -(-n // history_rows)
+    return np.append(ds[::stride], ds[n - 1]) if (n - 1) % stride else ds[::stride]
+
+
+def load(path, history_rows: int | None = None) -> dict:
     """Read a run file into plain Python: the keys of :func:`result_to_record`, plus
     ``units``, ``created`` and ``software_version`` from the file.
+
+    ``history_rows`` caps the history read (every n-th row and the last): a streamed history
+    of millions of rows need not be held to draw or show it.
 
     Raises ``ValueError`` naming the file if it is not a pulloff file of a known schema.
     """
@@ -198,7 +248,9 @@ def load(path) -> dict:
             "complete": bool(f.attrs["complete"]),
             "summary": _attrs(f["summary"]),
             "analytic": _attrs(f["analytic"]),
-            "history": {name: f["history"][name][()] for name in HISTORY_UNITS},
+            "history": {name: _read_rows(f["history"][name], history_rows)
+                        for name in HISTORY_UNITS},
+            "history_rows_in_file": int(f["history"]["t"].shape[0]),
             "units": {name: str(f["history"][name].attrs["unit"]) for name in HISTORY_UNITS},
             "snapshots": [],
         }

@@ -138,6 +138,64 @@ def onset_weights(k, c, dt, n_ages, nodes, complements, weights):
     return w_old, w_new
 
 
+#: ``binom(1/2, p)``: ``sqrt(m + u) = sqrt(m) sum_p BINOM_HALF[p] (u/m)^p`` for ``0 <= u <= 1``.
+#: Nine terms leave a truncation below 1e-17 relative from age ``ONSET_ASYMPTOTIC_AGE`` on.
+BINOM_HALF = np.array([1.0, 0.5, -0.125, 0.0625, -0.0390625, 0.02734375, -0.0205078125,
+                       0.01611328125, -0.013092041015625])
+ONSET_ASYMPTOTIC_AGE = 64
+
+
+@njit(cache=True)
+def onset_moments(k, c, dt, nodes, complements, weights):
+    """``(scale, m_old, m_new)`` that give :func:`onset_weights` at any age without a table.
+
+    For an age ``m`` of many steps ``sqrt(m + u)`` is expanded in ``u/m``; the weights become
+    ``scale sqrt(m) sum_p BINOM_HALF[p] m^-p m_old[p]`` (and ``m_new``), with the moments of
+    the exponential kernel over the step computed once. Long runs need this: a table per age
+    would grow with the number of steps.
+    """
+    n_terms = BINOM_HALF.shape[0]
+    m_old = np.zeros(n_terms)
+    m_new = np.zeros(n_terms)
+    sqrt_dt = math.sqrt(dt)
+    if c == 0.0:
+        # w_new = sqrt(dt (m + 1)) / k: every moment of u = 1 is 1.
+        for p in range(n_terms):
+            m_new[p] = 1.0
+        return sqrt_dt / k, m_old, m_new
+    theta = dt / c
+    mu = k * theta
+    for i in range(nodes.shape[0]):
+        y, u = _exp_map(nodes[i], complements[i], mu)
+        power = 1.0
+        for p in range(n_terms):
+            m_old[p] += weights[i] * power * y
+            m_new[p] += weights[i] * power * u
+            power *= u
+    return theta * sqrt_dt * phi1(mu), m_old, m_new
+
+
+@njit(cache=True)
+def onset_weight_pair(age, w_on_old, w_on_new, scale, m_old, m_new):
+    """Onset weights ``(w_old, w_new)`` of an element ``age`` steps old: from the tables while
+    they reach, from the moments of :func:`onset_moments` beyond (the tables must reach
+    ``ONSET_ASYMPTOTIC_AGE`` whenever an element can be older than them)."""
+    if age < w_on_old.shape[0]:
+        return w_on_old[age], w_on_new[age]
+    inv = 1.0 / age
+    power = 1.0
+    acc_old = 0.0
+    acc_new = 0.0
+    for p in range(BINOM_HALF.shape[0]):
+        acc_old += BINOM_HALF[p] * power * m_old[p]
+        acc_new += BINOM_HALF[p] * power * m_new[p]
+        power *= inv
+        if power < 1e-18:  # the remaining terms are below rounding (4 terms from age 2^16)
+            break
+    root = scale * math.sqrt(age)
+    return root * acc_old, root * acc_new
+
+
 @njit(cache=True)
 def onset_ratio(age, k, c):
     """``U / q`` of an element of the given age whose load grew like ``sqrt(age)``.
@@ -235,17 +293,20 @@ def step_preloaded(sigma, offset, U, kt_old, kt_new, s_old, s_new, decay, w_old,
 
 
 @njit(cache=True)
-def step_entered(sigma, U, n_born, step, s_old, s_new, k, decay, w_old, w_new):
+def step_entered(born, sigma, U, n_born, step, s_old, s_new, k, decay, w_old, w_new, scale,
+                 m_old, m_new):
     """Advance the elements that entered the zone at step boundaries by one step (in place).
 
-    Element ``j`` entered at step ``j``; at step ``step`` its age is ``step - j`` steps.
+    Element ``j`` entered at step ``born[j]``; at step ``step`` its age is ``step - born[j]``
+    steps. Ages beyond the tables use :func:`onset_weight_pair`'s expansion.
     """
     for j in range(n_born):
-        age = step - j
+        age = step - born[j]
         sg = sigma[j]
         r_old = math.sqrt(k * (sg + s_old))
         r_new = math.sqrt(k * (sg + s_new))
-        U[j] = decay * U[j] + w_old[age] * r_old + w_new[age] * r_new
+        wo, wn = onset_weight_pair(age, w_old, w_new, scale, m_old, m_new)
+        U[j] = decay * U[j] + wo * r_old + wn * r_new
 
 
 @njit(cache=True)
@@ -256,23 +317,69 @@ def interval_width(sigma_a, sigma_b):
 
 
 @njit(cache=True)
-def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, dx_born,
-                          n_born, S, kt, k_dt, ratio, w_young, w_old):
+def cubic_interval_weights(d_left, d, d_right, out):
+    """Weights on ``v`` at four nodes ``x0 < x1 < x2 < x3`` that integrate over ``[x1, x2]``
+    the cubic through them; ``d_left = x1 - x0``, ``d = x2 - x1``, ``d_right = x3 - x2``.
+    A zero ``d_left`` (or ``d_right``) means that node is missing: the quadratic through the
+    other three, with a zero weight for it. Written into ``out[0:4]``. Two-point
+    Gauss-Legendre on ``[x1, x2]`` is exact for cubics."""
+    xs = np.array([-d_left, 0.0, d, d + d_right])
+    present = np.array([d_left > 0.0, True, True, d_right > 0.0])
+    half = 0.5 * d
+    offset = d / (2.0 * math.sqrt(3.0))
+    for i in range(4):
+        out[i] = 0.0
+    for p in range(2):
+        z = half + (offset if p == 0 else -offset)
+        for i in range(4):
+            if not present[i]:
+                continue
+            basis = 1.0
+            for m in range(4):
+                if m != i and present[m]:
+                    basis *= (z - xs[m]) / (xs[i] - xs[m])
+            out[i] += half * basis
+
+
+@njit(cache=True)
+def preloaded_cubic_weights(dx_pre):
+    """:func:`cubic_interval_weights` of every interval of the preloaded nodes (the last one
+    ending at the oldest entered element): row ``i`` weighs ``v`` at nodes ``i-2 .. i+1``."""
+    n = dx_pre.shape[0]
+    out = np.zeros((n, 4))
+    for i in range(1, n):
+        d_left = dx_pre[i - 1] if i >= 2 else 0.0
+        d_right = dx_pre[i + 1] if i + 1 < n else 0.0
+        cubic_interval_weights(d_left, dx_pre[i], d_right, out[i])
+    return out
+
+
+@njit(cache=True)
+def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
+                          dx_born, thin_w, n_born, step, S, kt, k_dt, ratio, w_young, w_old):
     """``int_1^b U(x) / sqrt(b^2 - x^2) dx`` over the free zone (units of ``delta``).
 
     The field is written ``U = sqrt(b^2 - x^2) v(x)``, so no quadrature node sits on the
     singular end point and the elastic limit (``v = 1/k``) is integrated exactly. Elements
     loaded since ``t = 0`` (ascending ``sigma < s0``) and the oldest entered one use a
-    trapezoid on ``v`` in ``x``; the other entered ones (the last at ``b``, age 0) use
-    :func:`age_interval_weights`. ``dx_pre[i]`` is the width in ``x`` of the interval ending
-    at preloaded node ``i`` (``dx_pre[n_pre]``: the one ending at the oldest entered element),
-    ``dx_born[j]`` that ending at entered element ``j``: node positions never change, so the
-    widths are computed once, not every step. ``S - sigma`` comes from exact offsets:
-    ``offset_pre + k t`` for preloaded elements, ``k dt age`` for entered ones (``kt``, ``k_dt``).
+    trapezoid on ``v`` in ``x``, or, when ``pre_w`` has a row per interval
+    (:func:`preloaded_cubic_weights`, for a mesh that no longer refines with the step), the
+    cubic through four neighbours. Entered elements born on consecutive steps, younger than the
+    tables of :func:`age_interval_weights`, use those weights (the relaxation layer next to
+    ``b``); pairs born on consecutive steps but older than the tables use the trapezoid on
+    ``v``; pairs further apart (after :func:`thin_entered`) integrate the cubic through four
+    neighbours with the weights ``thin_w[j]`` on ``v`` at elements ``j-2 .. j+1``.
+    ``dx_pre[i]`` is the width in ``x`` of the interval ending at preloaded node ``i``
+    (``dx_pre[n_pre]``: the one ending at the oldest entered element), ``dx_born[j]`` that
+    ending at entered element ``j``: node positions never change, so the widths are computed
+    once, not every step. ``S - sigma`` comes from exact offsets: ``offset_pre + k t`` for
+    preloaded elements, ``k dt age`` for entered ones (``kt``, ``k_dt``); ``born[0]`` is 0.
     """
     total = 0.0
     n_pre = sig_pre.shape[0]
+    cubic = pre_w.shape[0] == n_pre + 1
     v_prev = 0.0
+    p1 = p2 = 0.0  # v at i - 3, i - 2 (v_prev is v at i - 1)
     for i in range(n_pre + 1):
         if i < n_pre:
             sg = sig_pre[i]
@@ -287,22 +394,87 @@ def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, 
             v = v_prev
         else:
             v = u / math.sqrt(ahead * (S + sg))
-        if i > 0:
+        if cubic:
+            if i >= 2:
+                w = pre_w[i - 1]
+                total += w[0] * p1 + w[1] * p2 + w[2] * v_prev + w[3] * v
+        elif i > 0:
             total += 0.5 * (v + v_prev) * dx_pre[i]
+        p1, p2 = p2, v_prev
         v_prev = v
-    # Entered elements, youngest (age 0) last; g = v / R(age) is smooth.
-    youngest = n_born - 1
-    g_old = 0.0
-    for j in range(n_born):
-        age = youngest - j
-        if j < youngest:
-            g = U_born[j] / math.sqrt(k_dt * age * (S + sig_born[j])) / ratio[age]
+    if cubic and n_pre >= 1:
+        w = pre_w[n_pre]
+        total += w[0] * p1 + w[1] * p2 + w[2] * v_prev
+    # Entered elements, youngest (age 0) last; g = v / R(age) is smooth. A thinned interval
+    # ending at j - 1 is added at j, once v at its right neighbour is known.
+    n_tab = w_young.shape[0]
+    g_prev = 0.0
+    age_prev = step
+    v1 = v2 = v3 = 0.0  # v at j - 3, j - 2, j - 1
+    thinned_pending = False
+    # A lone entered element (k = 0, or t = 0) was integrated with the preloaded ones.
+    for j in range(n_born if n_born > 1 else 0):
+        age = step - born[j]
+        if age > 0:
+            v = U_born[j] / math.sqrt(k_dt * age * (S + sig_born[j]))
+            g = v / ratio[age] if age <= n_tab else 0.0
         else:
-            g = g_old  # R(0) = 0: take g from the element one step older
+            g = g_prev  # R(0) = 0: take g from the element one step older
+            v = 0.0  # never used: the youngest pairs are always consecutive
+        if thinned_pending:
+            w = thin_w[j - 1]
+            total += w[0] * v1 + w[1] * v2 + w[2] * v3 + w[3] * v
+            thinned_pending = False
         if j > 0:
-            total += dx_born[j] * (g * w_young[age] + g_old * w_old[age])
-        g_old = g
+            gap_steps = age_prev - age
+            if gap_steps == 1 and age < n_tab:
+                total += dx_born[j] * (g * w_young[age] + g_prev * w_old[age])
+            elif gap_steps == 1:
+                total += 0.5 * dx_born[j] * (v + v3)
+            else:
+                thinned_pending = True
+        g_prev = g
+        v1, v2, v3 = v2, v3, v
+        age_prev = age
     return total
+
+
+@njit(cache=True)
+def thin_entered(born, sigma, U, dx, thin_w, n_born, step, keep_young, ratio_max):
+    """Drop entered elements so that the survivors are graded in age; returns the new count.
+
+    Elements younger than ``keep_young`` steps are all kept (they carry the relaxation layer
+    next to ``b`` and its product weights); the oldest element (born at step 0, the neighbour of
+    the preloaded zone) is kept. Among the others an element is dropped when its older kept
+    neighbour is at most ``ratio_max`` times as old as its younger one, so the gaps grow
+    geometrically with age, and the cubic on ``v`` over them keeps a relative error of order
+    ``(ratio_max - 1)^4``. Elements do not interact, so dropping one changes nothing but the
+    quadrature of the gap integral. Compacts the arrays in place and recomputes ``dx`` and the
+    cubic weights ``thin_w`` of every interval whose ends are not consecutive steps.
+    """
+    if n_born < 3:
+        return n_born
+    kept = 1
+    age_kept = step - born[0]
+    for j in range(1, n_born):
+        age = step - born[j]
+        if age >= keep_young and j + 1 < n_born:
+            age_next = step - born[j + 1]
+            if age_kept <= ratio_max * age_next:
+                continue
+        born[kept] = born[j]
+        sigma[kept] = sigma[j]
+        U[kept] = U[j]
+        dx[kept] = interval_width(sigma[kept - 1], sigma[kept])
+        age_kept = age
+        kept += 1
+    for j in range(1, kept):
+        if born[j] - born[j - 1] > 1:
+            # Cubic through j-2 .. j+1 (quadratic at the oldest interval); the youngest
+            # elements are kept consecutive, so j + 1 always exists here.
+            d_left = dx[j - 1] if j >= 2 else 0.0
+            cubic_interval_weights(d_left, dx[j], dx[j + 1], thin_w[j])
+    return kept
 
 
 @njit(cache=True)
@@ -315,38 +487,52 @@ def gap_from_integral(h, S, integral):
     return (2.0 / math.pi) * (h * math.atan(S) - integral)
 
 
+#: Return codes of :func:`march`.
+MARCH_STOPPED = 0
+MARCH_CROSSED = 1
+MARCH_FULL = 2
+
+
 @njit(cache=True)
-def march(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step,
-          step_stop, k, c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio,
-          w_young, w_old, t_out, gap_out):
+def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_born, thin_w,
+          n_born, step,
+          step_stop, k, c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale,
+          onset_m_old, onset_m_new, ratio, w_young, w_old, t_out, gap_out, row0):
     """Advance the foundation from step ``step`` until the gap reaches 1 or ``step_stop``.
 
-    ``sig_born``/``U_born``/``dx_born`` must have room for ``step_stop + 1`` elements (see
-    :func:`displacement_integral` for ``dx_pre``/``dx_born``); a new element is
-    placed at ``b`` after every step (``sigma = s(t)``), so element entries always fall on step
-    boundaries. ``t_out``/``gap_out`` receive the time and gap after each step, indexed by
-    step number. Returns ``(step, n_born, crossed)``.
+    A new element is placed at ``b`` after every step (``sigma = s(t)``), so element entries
+    always fall on step boundaries (see :func:`displacement_integral` for ``dx_pre``/
+    ``dx_born``). ``t_out``/``gap_out`` receive the time and gap after each step at row
+    ``step - row0`` and must reach ``step_stop - row0``. Returns ``(step, n_born, code)``:
+    ``MARCH_CROSSED`` when the gap reached 1, ``MARCH_FULL`` when the element arrays are full
+    (thin them with :func:`thin_entered` and call again), ``MARCH_STOPPED`` at ``step_stop``.
     """
+    capacity = sig_born.shape[0]
     while step < step_stop:
+        if k > 0.0 and n_born >= capacity:
+            return step, n_born, MARCH_FULL
         t_old = step * dt
         t_new = (step + 1) * dt
         s_old = k * (h0 + t_old) + c
         s_new = k * (h0 + t_new) + c
         step_preloaded(sig_pre, offset_pre, U_pre, k * t_old, k * t_new, s_old, s_new, decay,
                        w_pre_old, w_pre_new)
-        step_entered(sig_born, U_born, n_born, step, s_old, s_new, k, decay, w_on_old, w_on_new)
+        step_entered(born, sig_born, U_born, n_born, step, s_old, s_new, k, decay, w_on_old,
+                     w_on_new, onset_scale, onset_m_old, onset_m_new)
         step += 1
         if k > 0.0:
+            born[n_born] = step
             sig_born[n_born] = s_new
             U_born[n_born] = 0.0
             dx_born[n_born] = interval_width(sig_born[n_born - 1], s_new)
             n_born += 1
-        integral = displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born,
-                                         dx_born, n_born, s_new, k * t_new, k * dt, ratio,
-                                         w_young, w_old)
+        integral = displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born,
+                                         sig_born,
+                                         U_born, dx_born, thin_w, n_born, step, s_new,
+                                         k * t_new, k * dt, ratio, w_young, w_old)
         g = gap_from_integral(h0 + t_new, s_new, integral)
-        t_out[step] = t_new
-        gap_out[step] = g
+        t_out[step - row0] = t_new
+        gap_out[step - row0] = g
         if g >= 1.0:
-            return step, n_born, True
-    return step, n_born, False
+            return step, n_born, MARCH_CROSSED
+    return step, n_born, MARCH_STOPPED

@@ -74,7 +74,8 @@ def format_table(record: dict, title: str | None = None) -> str:
             lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
     for note in filter(None, str(s.get("notes", "")).split("; ")):
         lines.append(f"  note: {note}")
-    lines.append(f"  elements {s['n_elements']}, steps {s['n_steps']}, "
+    rows = record.get("history_rows_in_file", len(record["history"]["t"]))
+    lines.append(f"  elements {s['n_elements']}, steps {s['n_steps']}, history rows {rows}, "
                  f"wall time {s['wall_time'] * 1e3:.1f} ms")
     return "\n".join(lines)
 

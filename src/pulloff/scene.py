@@ -203,6 +203,14 @@ class Numerics(_Section):
     rtol: Num = Field(1e-6, ge=1e-10, le=1e-1,
                       description="target relative accuracy of F and t, dimensionless")
     t_max: Optional[Num] = Field(None, gt=0, description="end time, s; null: the solver chooses")
+    steps: Optional[Int] = Field(
+        None, ge=16, le=1_000_000_000,
+        description="fixed steps over the pull, count; null: chosen from rtol (a fixed run is "
+                    "checked against one at half the steps and streams its history)")
+    max_elements: Optional[Int] = Field(
+        None, ge=64, le=100_000_000,
+        description="element budget of a fixed-step run, count: when full, old elements are "
+                    "thinned; null: 4096 (only with numerics.steps)")
 
 
 class Output(_Section):
@@ -210,6 +218,8 @@ class Output(_Section):
 
     path: Optional[str] = Field(None, min_length=1, description="HDF5 result file, path; null: none")
     history_rows: Int = Field(2000, ge=2, description="max rows of the stored (decimated) history, count")
+    every: Optional[Int] = Field(
+        None, ge=1, description="keep every n-th step in the history, count; null: history_rows")
     snapshots: list[Annotated[Num, Field(ge=0)]] = Field(
         default_factory=list, description="times of stored displacement profiles, s")
 
@@ -229,6 +239,22 @@ class Scene(BaseModel):
     model: Model = Field(default_factory=Model, description="model variant section")
     numerics: Numerics = Field(default_factory=Numerics, description="solver accuracy section")
     output: Output = Field(default_factory=Output, description="output section")
+
+    @model_validator(mode="after")
+    def _stepping_needs_exact_history(self) -> Scene:
+        if self.model.history == "frozen":
+            for key in ("steps", "max_elements"):
+                value = getattr(self.numerics, key)
+                if value is not None:
+                    raise _bad_line(f"numerics.{key} = {_fmt(value)}: nothing is stepped with "
+                                    "model.history = frozen (a closed form); remove it")
+        if self.numerics.max_elements is not None and self.numerics.steps is None:
+            # rtol runs refine every element with the step; a fixed budget would put an
+            # error floor under the step-doubling estimate that it cannot see.
+            raise _bad_line(f"numerics.max_elements = {_fmt(self.numerics.max_elements)}: "
+                            "only with numerics.steps (rtol-controlled runs refine all "
+                            "elements with the step)")
+        return self
 
     def with_overrides(self, overrides: Sequence[str]) -> Scene:
         """A new scene with ``section.key=value`` overrides applied and re-validated."""

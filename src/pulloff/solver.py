@@ -14,6 +14,7 @@ from ``rtol``, checks it by step doubling, and converts back to SI.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -151,6 +152,8 @@ class FoundationRun:
     n_steps: int
     snapshots: list = field(default_factory=list)  # (t, sigma, U)
     interrupted: bool = False  # Ctrl-C arrived: the run holds what was computed until then
+    steps: np.ndarray | None = None  # step numbers of the recorded rows
+    n_thinned: int = 0  # times the element arrays were full and thinned
 
 
 def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
@@ -192,30 +195,106 @@ def preloaded_mesh(s0: float, n: int):
     return sigma, 2.0 * s0 * np.sin(0.5 * angles) ** 2
 
 
+#: Ages with tabulated weights; older elements use :func:`pulloff.kernels.onset_weight_pair`'s
+#: expansion and the trapezoid in the gap (identical to rounding), so the tables stay small
+#: however long the run.
+_TABLE_AGES = 1 << 16
+#: Rows of one ``march`` call's history buffer: the history in memory never grows with the run
+#: beyond what is recorded.
+_CHUNK_STEPS = 1 << 16
+_MIN_CHUNK = 2048
+
+
 def step_weights(k: float, c: float, dt: float, n_ages: int):
-    """All weights of one step size: ``(decay, w_pre_old, w_pre_new, w_on_old, w_on_new,
-    ratio, w_young, w_old)`` for :func:`pulloff.kernels.march`, for element ages up to
-    ``n_ages`` steps (tables of zeros when ``k = 0``: no element ever enters)."""
+    """All weights of one step size, in the order :func:`pulloff.kernels.march` takes them:
+    ``(decay, w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new,
+    ratio, w_young, w_old)``, tabulated for element ages up to ``min(n_ages, _TABLE_AGES)``
+    steps (tables of zeros when ``k = 0``: no element ever enters)."""
+    n_tab = max(kernels.ONSET_ASYMPTOTIC_AGE, min(n_ages, _TABLE_AGES))
     decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
+    rule = (kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
     if k > 0.0:
-        w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_ages, kernels.TS_NODES,
-                                                   kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
+        w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_tab, *rule)
+        scale, m_old, m_new = kernels.onset_moments(k, c, dt, *rule)
         ratio, w_young, w_old = kernels.age_interval_weights(
-            k, c, dt, n_ages, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
+            k, c, dt, n_tab, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
             kernels.TS_FINE_WEIGHTS)
     else:
-        w_on_old = w_on_new = np.zeros(n_ages)
-        ratio = w_young = w_old = np.zeros(n_ages + 1)
-    return decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old
+        w_on_old = w_on_new = np.zeros(n_tab)
+        scale, m_old, m_new = 0.0, np.zeros(kernels.BINOM_HALF.size), np.zeros(
+            kernels.BINOM_HALF.size)
+        ratio = np.zeros(n_tab + 1)
+        w_young = w_old = np.zeros(n_tab)
+    return (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio,
+            w_young, w_old)
+
+
+class _History:
+    """Rows of one run kept as they arrive: every ``every``-th step in memory, and every
+    ``stream_every``-th step handed to ``stream`` (SI columns, see :func:`si_history`), so
+    neither memory nor the kernel's buffer grows with the number of steps."""
+
+    def __init__(self, problem, every, stream=None, stream_every=1):
+        self.problem = problem
+        self.every = max(1, int(every))
+        self.stream = stream
+        self.stream_every = max(1, int(stream_every))
+        self.steps, self.gaps = [], []
+        self.tail = np.zeros((0, 2))  # the last three raw rows (time, gap): event location
+
+    def add(self, steps: np.ndarray, t: np.ndarray, gap: np.ndarray) -> None:
+        if self.every == 1:
+            self.steps.append(steps)
+            self.gaps.append(gap)
+        else:
+            keep = steps % self.every == 0
+            self.steps.append(steps[keep])
+            self.gaps.append(gap[keep])
+        if self.stream is not None:
+            # The crossing row lies past the event; the caller appends the event itself.
+            send = (steps % self.stream_every == 0) & (gap < 1.0)
+            if np.any(send):
+                self.stream(si_history(self.problem, t[send], gap[send]))
+        if t.size >= 3:
+            self.tail = np.column_stack([t[-3:], gap[-3:]])
+        else:
+            self.tail = np.concatenate([self.tail, np.column_stack([t, gap])])[-3:]
+
+    def arrays(self, dt, last_step):
+        steps = np.concatenate(self.steps) if self.steps else np.zeros(0, dtype=np.int64)
+        gaps = np.concatenate(self.gaps) if self.gaps else np.zeros(0)
+        if steps.size == 0 or steps[-1] != last_step:
+            # The run's last row always belongs to the history, recorded or not.
+            steps = np.append(steps, last_step)
+            gaps = np.append(gaps, self.tail[-1, 1])
+        return steps, steps * dt, gaps
+
+
+def si_history(problem: "Problem", t, gap) -> dict:
+    """History columns in SI from dimensionless times and gaps (see ``h5io.HISTORY_UNITS``)."""
+    return {
+        "t": t * problem.time_scale,
+        "h": problem.lift(t),
+        "b": problem.zone_end(t),
+        "gap": gap * problem.delta,
+        "F_contact": problem.contact_force(t),
+        "F_total": problem.total_force(t),
+    }
 
 
 def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
-                   progress=None, n_preloaded: int | None = None) -> FoundationRun:
+                   progress=None, n_preloaded: int | None = None, record_every: int = 1,
+                   max_elements: int | None = None, stream=None,
+                   stream_every: int = 1) -> FoundationRun:
     """Step the foundation with step ``dt`` until detachment or ``n_stop`` steps.
 
     Elements entering the zone are placed at ``b`` after every step, so their spacing is set by
     the step; ``n_preloaded`` (default: matched to that spacing) sets the mesh of the part of
-    the zone that is loaded from ``t = 0``.
+    the zone that is loaded from ``t = 0``. With ``max_elements`` the entered elements live in
+    arrays of that size: when they are full the old ones are thinned to a geometric grading
+    in age (:func:`pulloff.kernels.thin_entered`), so a run of any length keeps O(max_elements)
+    state. The history keeps every ``record_every``-th step in memory and hands every
+    ``stream_every``-th to ``stream`` (a callable taking :func:`si_history` columns).
     """
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     s0 = problem.s_of(0.0)
@@ -223,6 +302,10 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     # same range of sigma.
     s_ref = problem.s_of(n_stop * dt)
     n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
+    if max_elements is not None:
+        # A budget bounds this part too (a quarter of it): its mesh then stops refining with
+        # the step.
+        n_pre = min(n_pre, max(8, int(max_elements) // 4))
     sig_pre, offset_pre = preloaded_mesh(s0, n_pre)
     if c == 0.0:
         # An elastic element follows its load at once, also the step lift h0 at t = 0.
@@ -230,9 +313,14 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     else:
         U_pre = np.zeros_like(sig_pre)  # a damper cannot move instantly (MODEL.md: u(x,0) = 0)
     capacity = n_stop + 2
+    if max_elements is not None:
+        capacity = min(capacity, max(16, int(max_elements) - sig_pre.size))
+    born = np.zeros(capacity, dtype=np.int64)
     sig_born = np.zeros(capacity)
     U_born = np.zeros(capacity)
     dx_born = np.zeros(capacity)
+    # Quadrature weights of thinned intervals (only ever written by thinning).
+    thin_w = np.zeros((capacity if max_elements is not None else 1, 4))
     sig_born[0] = s0
     nodes_pre = np.append(sig_pre, s0)
     x_pre = np.sqrt(1.0 + nodes_pre * nodes_pre)
@@ -240,15 +328,18 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     dx_pre = np.zeros(nodes_pre.size)
     dx_pre[1:] = (np.diff(nodes_pre) * (nodes_pre[1:] + nodes_pre[:-1])
                   / (x_pre[1:] + x_pre[:-1]))
+    # With a budget the preloaded mesh stops refining with the step: the cubic on v keeps
+    # its error far below the trapezoid's (fourth order in its spacing).
+    pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
+             and sig_pre.size >= 3 else np.zeros((1, 4)))
     n_born = 1
-    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
-     w_old) = step_weights(k, c, dt, capacity)
-    t_out = np.zeros(capacity)
-    gap_out = np.zeros(capacity)
-    gap_out[0] = frozen_gap(problem, 0.0)  # the frozen and exact states agree at t = 0
-    snapshots = []
-    if gap_out[0] >= 1.0:
-        return FoundationRun(dt, t_out[:1], gap_out[:1], 0.0, sig_pre.size + n_born, 0)
+    weights = step_weights(k, c, dt, n_stop + 2)
+    history = _History(problem, record_every, stream, stream_every)
+    gap0 = float(frozen_gap(problem, 0.0))  # the frozen and exact states agree at t = 0
+    history.add(np.zeros(1, dtype=np.int64), np.zeros(1), np.array([gap0]))
+    if gap0 >= 1.0:
+        return FoundationRun(dt, np.zeros(1), np.array([gap0]), 0.0, sig_pre.size + n_born, 0,
+                             steps=np.zeros(1, dtype=np.int64))
 
     # Stops for snapshots and progress; the kernel runs uninterrupted between them. A snapshot
     # between two steps interpolates the states at both ends (second order, like the stepper).
@@ -260,39 +351,74 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     captured = {}
     if 0 in capture_steps:
         captured[0] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
-    chunk = max(1, n_stop // 50)
+    # ~50 stops for progress and Ctrl-C (a signal is seen when the kernel returns; the rows
+    # of that call are lost); at least _MIN_CHUNK steps each, so small runs pay no overhead.
+    chunk = max(_MIN_CHUNK, n_stop // 50)
     stops = sorted((set(range(chunk, n_stop, chunk)) | capture_steps | {n_stop}) - {0})
+    buffer = min(n_stop, _CHUNK_STEPS)
+    t_buf = np.zeros(buffer + 1)
+    gap_buf = np.zeros(buffer + 1)
     step = 0
     crossed = False
     interrupted = False
-    for stop in stops:
-        step_before = step
-        try:
-            step, n_born, crossed = kernels.march(
-                sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, dx_born, n_born, step,
-                stop, k, c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio,
-                w_young, w_old, t_out, gap_out)
-        except KeyboardInterrupt:
-            # Compiled code does not see signals; Python raises on return, before ``step``
-            # is updated, so the arrays hold a consistent state up to ``step``.
-            interrupted = True
-            break
-        if progress is not None:
-            progress(step - step_before)
-        if step in capture_steps:
-            captured[step] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
-        if crossed:
-            break
-    t_detach = _crossing_time(t_out, gap_out, step) if crossed else math.nan
+    n_thinned = 0
+    try:
+        for stop in stops:
+            while step < stop:
+                row0 = step
+                step_new, n_born, code = kernels.march(
+                    sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
+                    dx_born, thin_w, n_born, step, min(stop, row0 + buffer), k, c, h0, dt, *weights, t_buf,
+                    gap_buf, row0)
+                rows = step_new - row0
+                history.add(np.arange(row0 + 1, step_new + 1), t_buf[1:rows + 1].copy(),
+                            gap_buf[1:rows + 1].copy())
+                step = step_new
+                if progress is not None:
+                    progress(rows)
+                if code == kernels.MARCH_CROSSED:
+                    crossed = True
+                    break
+                if code == kernels.MARCH_FULL:
+                    n_born = _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step)
+                    n_thinned += 1
+            if step in capture_steps:
+                captured[step] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
+            if crossed:
+                break
+    except KeyboardInterrupt:
+        # Compiled code does not see signals; Python raises on return, before ``step`` is
+        # updated, so the arrays and the history hold a consistent state up to ``step``.
+        interrupted = True
+    t_detach = math.nan
+    if crossed:
+        tail = history.tail
+        t_detach = _crossing_time(tail[:, 0], tail[:, 1], tail.shape[0] - 1)
     t_end = t_detach if crossed else step * dt
+    snapshots = []
     for ts in sorted(wanted):
         n0, n1 = wanted[ts]
         # Only times the run reached: none after detachment or past t_max.
         if ts <= t_end and n0 in captured and n1 in captured:
             snapshots.append((ts, *_interpolate_field(problem, captured[n0], captured[n1],
                                                       ts / dt - n0, ts)))
-    return FoundationRun(dt, t_out[:step + 1].copy(), gap_out[:step + 1].copy(), t_detach,
-                         sig_pre.size + n_born, step, snapshots, interrupted)
+    steps, t, gap = history.arrays(dt, step)
+    return FoundationRun(dt, t, gap, t_detach, sig_pre.size + n_born, step, snapshots,
+                         interrupted, steps=steps, n_thinned=n_thinned)
+
+
+def _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step) -> int:
+    """Thin full element arrays to at most half their size (see ``kernels.thin_entered``)."""
+    capacity = sig_born.size
+    keep_young = capacity // 4
+    # A geometric grading from keep_young to the oldest age in capacity/4 elements.
+    oldest = max(step - born[0], keep_young + 1)
+    ratio_max = math.exp(math.log(oldest / keep_young) / (capacity // 4))
+    n_kept = kernels.thin_entered(born, sig_born, U_born, dx_born, thin_w, n_born, step,
+                                  keep_young, ratio_max)
+    if n_kept > capacity // 2 + capacity // 4:
+        raise RuntimeError(f"thinning kept {n_kept} of {capacity} elements")  # a bug, not input
+    return n_kept
 
 
 def _interpolate_field(problem, field0, field1, weight, t):
@@ -303,7 +429,12 @@ def _interpolate_field(problem, field0, field1, weight, t):
     if weight <= 0.0:
         return sig0.copy(), U0.copy()
     n = sig0.size
-    U = (1.0 - weight) * U0 + weight * U1[:n]
+    if sig1.size >= n and np.array_equal(sig1[:n], sig0):
+        U1_at_0 = U1[:n]
+    else:
+        # Old elements were thinned in between: the newer field, interpolated to the older nodes.
+        U1_at_0 = np.interp(sig0, sig1, U1)
+    U = (1.0 - weight) * U0 + weight * U1_at_0
     s_t = problem.s_of(t)
     if s_t > sig0[-1]:
         return np.append(sig0, s_t), np.append(U, 0.0)
@@ -342,6 +473,7 @@ class Result:
     snapshots: list  # (t [s], x [m], u [m])
     groups: dict  # alpha, chi, V
     analytic: dict  # closed forms, SI
+    history_streamed: bool = False  # the full history went to a stream; ``history`` previews it
 
 
 def _n_steps_for(rtol: float) -> int:
@@ -352,13 +484,19 @@ def _detach_outputs(problem: Problem, t: float):
     return np.array([t, problem.contact_force(t), problem.total_force(t)], dtype=float)
 
 
-def simulate(scene, progress: bool = False) -> Result:
+def simulate(scene, progress: bool = False, stream=None) -> Result:
     """Run a scene: exact history by time stepping, frozen history in closed form.
 
     ``numerics.rtol`` is the target relative error of the detachment time and forces. The
     exact model is run at ``N`` and ``2N`` steps per reference time; the second-order stepper's
     error is estimated as a third of their difference (Richardson) and ``N`` doubles until the
     estimate is below ``rtol / 2``. The finer run is reported, with its estimate.
+
+    With ``numerics.steps`` the pull is run at that many steps instead, after one run at half
+    as many for the error estimate. Its history goes to ``stream`` as it is computed (a
+    callable taking :func:`si_history` columns, e.g. :class:`pulloff.h5io.HistoryStream`);
+    ``Result.history`` then holds a preview of at most ``output.history_rows`` rows and
+    ``Result.history_streamed`` is true.
     """
     wall_start = time.perf_counter()
     problem = Problem.from_scene(scene)
@@ -368,22 +506,52 @@ def simulate(scene, progress: bool = False) -> Result:
     t_frozen = frozen_detach_time(problem, t_limit)
     snapshot_times = [ts / T for ts in scene.output.snapshots]
 
+    notes = []
+    streamed = False
     if scene.model.history == "frozen":
         run, error_estimate = _frozen_run(problem, t_frozen, t_limit, scene.output.history_rows,
                                           snapshot_times)
+    elif scene.numerics.steps is not None:
+        run, error_estimate = _fixed_run(problem, t_frozen, t_limit, scene, snapshot_times,
+                                         progress, stream)
+        streamed = stream is not None
+        if not error_estimate <= rtol and not run.interrupted and run.t.size > 1:
+            notes.append(f"error estimate {error_estimate:.2g} above rtol {rtol:g} at the fixed "
+                         f"{scene.numerics.steps} steps")
     else:
         run, error_estimate = _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times,
-                                         progress)
-    notes = []
-    if not error_estimate <= rtol and run.t.size > 1 and not run.interrupted:
-        notes.append(f"not converged: error estimate {error_estimate:.2g} above rtol {rtol:g} "
-                     f"at the step cap ({_MAX_STEPS} steps)")
+                                         progress, scene.output.every,
+                                         scene.numerics.max_elements)
+        if not error_estimate <= rtol and run.t.size > 1 and not run.interrupted:
+            notes.append(f"not converged: error estimate {error_estimate:.2g} above rtol "
+                         f"{rtol:g} at the step cap ({_MAX_STEPS} steps)")
+    if run.n_thinned:
+        notes.append(f"element arrays thinned {run.n_thinned} times (numerics.max_elements)")
     t_reached = run.t_detach if not math.isnan(run.t_detach) else run.t[-1]
     for ts in scene.output.snapshots:
         if ts / T > t_reached:
             notes.append(f"snapshot at t = {ts:g} s skipped: after the end of the run")
-    return _assemble(scene, problem, run, error_estimate, time.perf_counter() - wall_start,
-                     notes)
+    if streamed:
+        # The stream ends exactly at the event, or at the last step reached.
+        if not math.isnan(run.t_detach):
+            stream(si_history(problem, np.array([run.t_detach]), np.array([1.0])))
+        elif run.steps[-1] % _stream_every(scene) != 0:
+            stream(si_history(problem, run.t[-1:], run.gap[-1:]))
+    result = _assemble(scene, problem, run, error_estimate, time.perf_counter() - wall_start,
+                       notes)
+    result.history_streamed = streamed
+    return result
+
+
+#: Steps of the fixed-step mode's default element arrays (``numerics.max_elements``).
+_FIXED_MAX_ELEMENTS = 4096
+
+
+def _stream_every(scene) -> int:
+    steps = scene.numerics.steps
+    if scene.output.every is not None:
+        return scene.output.every
+    return max(1, math.ceil(steps / scene.output.history_rows))
 
 
 def _frozen_run(problem, t_frozen, t_limit, rows, snapshot_times):
@@ -398,12 +566,72 @@ def _frozen_run(problem, t_frozen, t_limit, rows, snapshot_times):
             sig = s * np.cos(np.linspace(0.5 * np.pi, 0.0, 65))
             q = np.sqrt(np.maximum((s - sig) * (s + sig), 0.0))
             snapshots.append((ts, sig, q * frozen_memory(problem, ts)))
-    run = FoundationRun(math.nan, t, gap, t_frozen if detached else math.nan, 0, 0, snapshots)
+    run = FoundationRun(math.nan, t, gap, t_frozen if detached else math.nan, 0, 0, snapshots,
+                        steps=np.arange(t.size))
     # The root is found to rounding; the estimate is that of brentq's tolerance.
     return run, 4e-16 * 8
 
 
-def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress):
+def _pull_time(problem, t_frozen, t_limit):
+    """Time span for a fixed step count: the detachment time of a cheap pilot run (64 steps
+    over the frozen bound, which bounds it from above) with a small margin, or ``t_max``."""
+    t_ref = min(t_frozen, t_limit)
+    if t_ref == 0.0 or not math.isfinite(t_ref):
+        return t_ref
+    pilot = run_foundation(problem, t_ref / 64, 68)
+    if math.isfinite(pilot.t_detach) and pilot.t_detach > 0:
+        # The pilot's error is ~1e-2/64^2: 2 % keeps the event inside the span.
+        t_ref = min(t_ref, 1.02 * pilot.t_detach)
+    return t_ref
+
+
+def _fixed_run(problem, t_frozen, t_limit, scene, snapshot_times, progress, stream):
+    """``numerics.steps`` over the pull, checked by a run with half the steps and
+    ``1/sqrt(2)`` of the element budget. The step error is second order, the budget's
+    (thinned and fixed meshes, fourth-order quadrature) grows 2.8-5.7 times as the budget
+    shrinks by ``sqrt(2)`` (measured orders 3-5 in the budget); so a third of the difference
+    is within a factor 1/3..2 of the finer run's error whichever dominates."""
+    n = scene.numerics.steps
+    max_elements = scene.numerics.max_elements or _FIXED_MAX_ELEMENTS
+    t_ref = _pull_time(problem, t_frozen, t_limit)
+    if t_ref == 0.0:
+        return run_foundation(problem, 1.0, 0), 0.0
+
+    def steps_to_cover(m):
+        return m if t_ref >= t_limit else m + max(2, m // 16)
+
+    preview = max(1, math.ceil(steps_to_cover(n) / scene.output.history_rows))
+    runs = []
+    # The streamed run first: a Ctrl-C during the check leaves its whole history in the file.
+    for m, budget, sink in ((n, max_elements, stream),
+                            (n // 2, max(64, int(max_elements / math.sqrt(2.0))), None)):
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=steps_to_cover(m), desc=f"{m} steps", unit="step", leave=False)
+        try:
+            runs.append(run_foundation(problem, t_ref / m, steps_to_cover(m),
+                                       snapshot_times if sink is stream else (),
+                                       progress=bar.update if bar else None,
+                                       record_every=preview, max_elements=budget,
+                                       stream=sink, stream_every=_stream_every(scene)))
+        finally:
+            if bar is not None:
+                bar.close()
+        if runs[-1].interrupted:
+            return dataclasses.replace(runs[0], interrupted=True), math.nan
+    full, half = runs
+    if math.isnan(half.t_detach) or math.isnan(full.t_detach):
+        return full, _gap_difference(half, full)
+    if full.t_detach == 0.0:
+        return full, 0.0
+    values = [_detach_outputs(problem, r.t_detach) for r in runs]
+    return full, float(np.max(np.abs(values[0] - values[1]) / np.abs(values[0])) / 3.0)
+
+
+def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress, every=None,
+               max_elements=None):
     t_ref = min(t_frozen, t_limit)
     if t_ref == 0.0:
         return run_foundation(problem, 1.0, 0), 0.0
@@ -413,14 +641,22 @@ def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress):
         # hair beyond it; a few spare steps are cheap. A user's t_max is a hard end.
         return n if t_ref >= t_limit else n + max(2, n // 16)
 
+    def level(n, snapshots=(), progress=None):
+        # In memory: every user-chosen step, or a power of two that keeps ~2000-4000 rows and
+        # lands the rows of consecutive levels on common times (for the gap comparison).
+        record = every if every is not None else max(1, n // 2048)
+        return run_foundation(problem, t_ref / n, steps_to_cover(n), snapshots,
+                              progress=progress, record_every=record,
+                              max_elements=max_elements)
+
     n = max(_MIN_STEPS // 2, _n_steps_for(rtol) // 2)
-    levels = [run_foundation(problem, t_ref / n, steps_to_cover(n))]
+    levels = [level(n)]
     coarse = levels[0]
     # The exact model can detach well before the frozen bound; re-centre the grid on the
     # coarse crossing so that the step count measures the pull that actually happens.
     if coarse.n_steps < n // 2 and math.isfinite(coarse.t_detach) and coarse.t_detach > 0:
         t_ref = min(t_ref, 1.25 * coarse.t_detach * (1.0 + 2.0 / n))
-        levels = [run_foundation(problem, t_ref / n, steps_to_cover(n))]
+        levels = [level(n)]
     if levels[-1].interrupted:
         return levels[-1], math.nan
     while True:
@@ -431,8 +667,7 @@ def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress):
 
             bar = tqdm(total=steps_to_cover(n), desc=f"{n} steps", unit="step", leave=False)
         try:
-            levels.append(run_foundation(problem, t_ref / n, steps_to_cover(n),
-                                         snapshot_times, progress=bar.update if bar else None))
+            levels.append(level(n, snapshot_times, bar.update if bar else None))
         finally:
             if bar is not None:
                 bar.close()
@@ -473,11 +708,13 @@ def _error_estimate(problem, levels) -> float:
 
 
 def _gap_difference(coarse: FoundationRun, fine: FoundationRun) -> float:
-    m = min(coarse.gap.size, (fine.gap.size + 1) // 2)
-    if m < 2:
+    """A third of the largest gap difference of two runs (step ratio 2) at their common
+    recorded times, relative to the largest gap: the estimate when neither detaches."""
+    _, i_c, i_f = np.intersect1d(2 * coarse.steps, fine.steps, return_indices=True)
+    if i_c.size < 2:
         return 0.0
-    g_c = coarse.gap[:m]
-    g_f = fine.gap[: 2 * m - 1: 2]
+    g_c = coarse.gap[i_c]
+    g_f = fine.gap[i_f]
     return float(np.max(np.abs(g_f - g_c)) / max(np.max(np.abs(g_f)), 1e-300)) / 3.0
 
 
@@ -497,16 +734,11 @@ def _assemble(scene, problem: Problem, run: FoundationRun, error_estimate: float
         keep = t_hist < run.t_detach
         t_hist = np.append(t_hist[keep], run.t_detach)
         gap_hist = np.append(gap_hist[keep], 1.0)
-    rows = _decimate(t_hist.size, scene.output.history_rows)
-    t_hist, gap_hist = t_hist[rows], gap_hist[rows]
-    history = {
-        "t": t_hist * T,
-        "h": problem.lift(t_hist),
-        "b": problem.zone_end(t_hist),
-        "gap": gap_hist * problem.delta,
-        "F_contact": problem.contact_force(t_hist),
-        "F_total": problem.total_force(t_hist),
-    }
+    if scene.output.every is None or scene.numerics.steps is not None:
+        # (A fixed-step run's full history is streamed; this is its preview.)
+        rows = _decimate(t_hist.size, scene.output.history_rows)
+        t_hist, gap_hist = t_hist[rows], gap_hist[rows]
+    history = si_history(problem, t_hist, gap_hist)
     td = run.t_detach
     nan = math.nan
     snapshots = [(ts * T, problem.a * np.sqrt(1.0 + sig * sig), problem.delta * U)
