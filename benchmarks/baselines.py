@@ -156,8 +156,11 @@ def march_numpy(problem: Problem, dt: float, n_stop: int,
     U_1 = np.zeros(sig_1.size)
     U_pre = U_1[:-1]
 
-    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
+    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, _, _, _, ratio, w_young,
      w_old) = step_weights(k, c, dt, capacity)
+    if capacity > w_on_old.size:
+        raise ValueError(f"march_numpy reads weight tables by age: at most {w_on_old.size} "
+                         f"steps, not {n_stop}")
     t_out = np.zeros(capacity)
     gap_out = np.zeros(capacity)
     gap_out[0] = kernels.gap_from_integral.py_func(h0, s0, 0.0)

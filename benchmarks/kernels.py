@@ -76,6 +76,9 @@ def kernel_calls(problem: Problem, n: int):
     fine = (kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS, kernels.TS_FINE_WEIGHTS)
     w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n + 2, *tables)
     ratio, w_young, w_aged = kernels.age_interval_weights(k, c, dt, n + 2, *fine)
+    moments = kernels.onset_moments(k, c, dt, *tables)
+    born = np.arange(n + 1, dtype=np.int64)  # element j entered at step j
+    no_cubic = np.zeros((1, 4))  # trapezoid/product weights, as in a run without a budget
     sig_pre, U_pre = a["sig_pre"], a["U_pre"]
     sig_born, U_born = a["sig_born"][:n], a["U_born"][:n]
     # For the gap integral: half the elements preloaded, half entered (n in total).
@@ -93,10 +96,14 @@ def kernel_calls(problem: Problem, n: int):
             sig_pre, a["offset_pre"], U_pre, k * (t_now - dt), k * t_now, S - k * dt, S, decay,
             w_old, w_new), n),
         "step_entered": (lambda: kernels.step_entered(
-            sig_born, U_born, n, n - 1, S - k * dt, S, k, decay, w_on_old, w_on_new), n),
+            sig_born, U_born, 0, n, n - 1, S - k * dt, S, k, decay, w_on_old, w_on_new), n),
+        "step_entered_aged": (lambda: kernels.step_entered_aged(
+            born[:n], sig_born, U_born, n, n - 1, S - k * dt, S, k, decay, w_on_old[:64],
+            w_on_new[:64], *moments), n),
         "displacement_integral": (lambda: kernels.displacement_integral(
-            sig_p, off_p, U_p, dx_p, a["sig_born"], a["U_born"], dx_b, n - half, S, k * t_now,
-            k * dt, ratio, w_young, w_aged), n),
+            sig_p, off_p, U_p, dx_p, no_cubic, born, a["sig_born"], a["U_born"], dx_b,
+            no_cubic, n - half, n - half - 1, S, k * t_now, k * dt, ratio, w_young, w_aged),
+            n),
         "onset_weights": (lambda: kernels.onset_weights(k, c, dt, n, *tables), n),
         "age_interval_weights": (lambda: kernels.age_interval_weights(k, c, dt, n, *fine), n),
     }
@@ -117,8 +124,8 @@ def march_call(problem: Problem, n_steps: int):
     dx_pre = np.append(0.0, [kernels.interval_width(x, y) for x, y in zip(nodes[:-1],
                                                                           nodes[1:])])
     capacity = n_steps + 2
-    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young,
-     w_old) = step_weights(k, c, dt, capacity)
+    weights = step_weights(k, c, dt, capacity)
+    no_cubic = np.zeros((1, 4))
 
     def call():
         # Fresh state per call: march advances U and places elements in place.
@@ -127,13 +134,13 @@ def march_call(problem: Problem, n_steps: int):
         sig_born[0] = s0
         U_born = np.zeros(capacity)
         dx_born = np.zeros(capacity)
+        born = np.zeros(capacity, dtype=np.int64)
         t_out = np.zeros(capacity)
         gap_out = np.zeros(capacity)
-        step, n_born, crossed = kernels.march(
-            sig_pre0, offset_pre0, U_pre, dx_pre, sig_born, U_born, dx_born, 1, 0, n_steps, k,
-            c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, ratio, w_young, w_old,
-            t_out, gap_out)
-        assert step == n_steps and not crossed
+        step, n_born, code = kernels.march(
+            sig_pre0, offset_pre0, U_pre, dx_pre, no_cubic, born, sig_born, U_born, dx_born,
+            no_cubic, 1, 0, 0, n_steps, k, c, h0, dt, *weights, t_out, gap_out, 0)
+        assert step == n_steps and code == kernels.MARCH_STOPPED
         return n_born
 
     # Step m (from 0) advances n_pre + m + 1 elements (and integrates over them and the new
@@ -223,16 +230,19 @@ def report_march(problem: Problem):
     # Cost of one numba dispatch of march with its 24 arguments (a call that does no step).
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     z = np.zeros(4)
+    z2 = np.zeros((1, 4))
+    zi = np.zeros(4, dtype=np.int64)
+    weights = step_weights(k, c, 1.0, 4)
 
     def no_step():
-        return kernels.march(z, z, z, z, z, z, z, 1, 0, 0, k, c, h0, 1.0, 0.0, 0.0, 0.0, z, z, z,
-                             z, z, z, z)
+        return kernels.march(z, z, z, z, z2, zi, z, z, z, z2, 1, 0, 0, 0, k, c, h0, 1.0, *weights,
+                             z, z, 0)
 
     no_step()
     timing, _ = time_call(no_step, min_repeats=MIN_REPEATS, min_total=MIN_TOTAL)
     out(f"  dispatch of one march call that does no step: {1e6 * timing.median:.2f} us "
-        f"(run_foundation calls march about 50 times per run, in chunks, for its progress "
-        f"bar)")
+        f"(run_foundation calls march once per 2048 steps or 1/50 of the run, whichever is "
+        f"longer, for its progress bar and Ctrl-C)")
     return rows
 
 

@@ -138,8 +138,11 @@ def test_entered_element_matches_ode_solution():
     for step in range(n):
         s_old = k * (h0 + step * dt) + c
         s_new = k * (h0 + (step + 1) * dt) + c
-        K.step_entered(np.zeros(1, dtype=np.int64), sig, U, 1, step, s_old, s_new, k, decay,
-                       w_old, w_new, *moments)
+        if step % 2:  # both update paths: tables by consecutive age, and by born step
+            K.step_entered(sig, U, 0, 1, step, s_old, s_new, k, decay, w_old, w_new)
+        else:
+            K.step_entered_aged(np.zeros(1, dtype=np.int64), sig, U, 1, step, s_old, s_new, k,
+                                decay, w_old, w_new, *moments)
 
     def load(t):
         s = k * (h0 + t) + c

@@ -293,20 +293,33 @@ def step_preloaded(sigma, offset, U, kt_old, kt_new, s_old, s_new, decay, w_old,
 
 
 @njit(cache=True)
-def step_entered(born, sigma, U, n_born, step, s_old, s_new, k, decay, w_old, w_new, scale,
-                 m_old, m_new):
-    """Advance the elements that entered the zone at step boundaries by one step (in place).
-
-    Element ``j`` entered at step ``born[j]``; at step ``step`` its age is ``step - born[j]``
-    steps. Ages beyond the tables use :func:`onset_weight_pair`'s expansion.
-    """
-    for j in range(n_born):
-        age = step - born[j]
-        sg = sigma[j]
+def step_entered(sigma, U, j_first, n_born, age_base, s_old, s_new, k, decay, w_old, w_new):
+    """Advance entered elements ``j_first .. n_born - 1``, born on consecutive steps, by one
+    step (in place): element ``j`` is ``age_base - j`` steps old, within the tables. This loop
+    is all there is in a run without a budget; kept free of branches, it vectorises."""
+    # Views from j_first and an index from 0: written as a loop over j from j_first, LLVM
+    # does not vectorise it (measured 5 ns against 1.2 ns per element).
+    sig_tail = sigma[j_first:n_born]
+    U_tail = U[j_first:n_born]
+    top = age_base - j_first
+    for i in range(n_born - j_first):
+        age = top - i
+        sg = sig_tail[i]
         r_old = math.sqrt(k * (sg + s_old))
         r_new = math.sqrt(k * (sg + s_new))
-        wo, wn = onset_weight_pair(age, w_old, w_new, scale, m_old, m_new)
-        U[j] = decay * U[j] + wo * r_old + wn * r_new
+        U_tail[i] = decay * U_tail[i] + w_old[age] * r_old + w_new[age] * r_new
+
+
+@njit(cache=True)
+def step_entered_aged(born, sigma, U, j_stop, step, s_old, s_new, k, decay, w_old, w_new, scale,
+                      m_old, m_new):
+    """Advance entered elements ``0 .. j_stop - 1`` by one step (in place): those left apart
+    by thinning or older than the tables. Element ``j`` entered at step ``born[j]``; ages
+    beyond the tables use :func:`onset_weight_pair`'s expansion."""
+    for j in range(j_stop):
+        sg = sigma[j]
+        wo, wn = onset_weight_pair(step - born[j], w_old, w_new, scale, m_old, m_new)
+        U[j] = decay * U[j] + wo * math.sqrt(k * (sg + s_old)) + wn * math.sqrt(k * (sg + s_new))
 
 
 @njit(cache=True)
@@ -495,7 +508,7 @@ MARCH_FULL = 2
 
 @njit(cache=True)
 def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_born, thin_w,
-          n_born, step,
+          n_born, j_consecutive, step,
           step_stop, k, c, h0, dt, decay, w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale,
           onset_m_old, onset_m_new, ratio, w_young, w_old, t_out, gap_out, row0):
     """Advance the foundation from step ``step`` until the gap reaches 1 or ``step_stop``.
@@ -503,11 +516,13 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
     A new element is placed at ``b`` after every step (``sigma = s(t)``), so element entries
     always fall on step boundaries (see :func:`displacement_integral` for ``dx_pre``/
     ``dx_born``). ``t_out``/``gap_out`` receive the time and gap after each step at row
-    ``step - row0`` and must reach ``step_stop - row0``. Returns ``(step, n_born, code)``:
+    ``step - row0`` and must reach ``step_stop - row0``. Elements from ``j_consecutive`` on
+    were born on consecutive steps (thinning only removes older ones). Returns ``(step, n_born, code)``:
     ``MARCH_CROSSED`` when the gap reached 1, ``MARCH_FULL`` when the element arrays are full
     (thin them with :func:`thin_entered` and call again), ``MARCH_STOPPED`` at ``step_stop``.
     """
     capacity = sig_born.shape[0]
+    n_tab = w_on_old.shape[0]
     while step < step_stop:
         if k > 0.0 and n_born >= capacity:
             return step, n_born, MARCH_FULL
@@ -517,8 +532,15 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
         s_new = k * (h0 + t_new) + c
         step_preloaded(sig_pre, offset_pre, U_pre, k * t_old, k * t_new, s_old, s_new, decay,
                        w_pre_old, w_pre_new)
-        step_entered(born, sig_born, U_born, n_born, step, s_old, s_new, k, decay, w_on_old,
-                     w_on_new, onset_scale, onset_m_old, onset_m_new)
+        # Ages fall with j: thinned elements and those older than the tables come first.
+        j_split = j_consecutive
+        while j_split < n_born and step - born[j_split] >= n_tab:
+            j_split += 1
+        step_entered_aged(born, sig_born, U_born, j_split, step, s_old, s_new, k, decay,
+                          w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new)
+        if j_split < n_born:
+            step_entered(sig_born, U_born, j_split, n_born, step - born[j_split] + j_split,
+                         s_old, s_new, k, decay, w_on_old, w_on_new)
         step += 1
         if k > 0.0:
             born[n_born] = step

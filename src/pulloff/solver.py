@@ -362,13 +362,14 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     crossed = False
     interrupted = False
     n_thinned = 0
+    j_consecutive = 0
     try:
         for stop in stops:
             while step < stop:
                 row0 = step
                 step_new, n_born, code = kernels.march(
                     sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
-                    dx_born, thin_w, n_born, step, min(stop, row0 + buffer), k, c, h0, dt, *weights, t_buf,
+                    dx_born, thin_w, n_born, j_consecutive, step, min(stop, row0 + buffer), k, c, h0, dt, *weights, t_buf,
                     gap_buf, row0)
                 rows = step_new - row0
                 history.add(np.arange(row0 + 1, step_new + 1), t_buf[1:rows + 1].copy(),
@@ -381,6 +382,9 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
                     break
                 if code == kernels.MARCH_FULL:
                     n_born = _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step)
+                    # The young elements thinning keeps are the consecutive tail.
+                    gaps = np.nonzero(np.diff(born[:n_born]) > 1)[0]
+                    j_consecutive = int(gaps[-1]) + 1 if gaps.size else 0
                     n_thinned += 1
             if step in capture_steps:
                 captured[step] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
