@@ -495,6 +495,50 @@ def elastic_mdr_dugdale(G, sigma_c, delta, a):
     return dict(b=b, h=h, F_contact=F_contact, F_total=F_total, S=S)
 
 
+def elastic_internal_onset(G, sigma_c, delta, R):
+    """Exact elastic MDR-Dugdale onset for a punch whose cohesive zone lies on its own face.
+
+    Inputs: G [Pa] (> 0), sigma_c [Pa], delta [m], R [m] (the punch radius). The zone spans
+    ``a < r < R`` (``b = R``); with ``a = R cos(theta)`` the edge condition gives
+    ``2 G h = sigma_c R sin(theta)`` and the gap at the rim (MODEL.md section 5 with ``b = R``)
+    ``(sigma_c R / (pi G)) [theta sin(theta) - 2 sin^2(theta/2)] = delta``, i.e.
+    ``g(theta) = chi_R = pi G delta / (sigma_c R)``. ``g`` grows from 0 to ``pi/2 - 1`` as the
+    bond shrinks to nothing; for ``chi_R >= pi/2 - 1`` the bond is gone (``a = 0``) before the
+    gap reaches ``delta``: the strength limit, ``F_total = pi R^2 sigma_c``.
+
+    Returns ``dict(a=[m], h=[m], F_contact=[N], F_total=[N], theta=[rad],
+    strength_limited=bool)``: ``F_contact = 8 a G h = 4 sigma_c R^2 cos(theta) sin(theta)``,
+    ``F_total = 2 sigma_c R^2 [cos(theta) sin(theta) + theta]`` (the whole line load). An
+    elastic crack is unstable under a rigid lift, so these are also the peak forces.
+    """
+    G, sigma_c, delta, R = map(float, (G, sigma_c, delta, R))
+    if not (G > 0 and sigma_c > 0 and R > 0 and delta >= 0):
+        raise ValueError("need G > 0, sigma_c > 0, R > 0, delta >= 0")
+    chi_R = math.pi * G * delta / (sigma_c * R)
+
+    def g(theta):
+        return theta * math.sin(theta) - 2.0 * math.sin(0.5 * theta) ** 2
+
+    strength_limited = chi_R >= _PI_2_M1
+    if strength_limited:
+        theta = 0.5 * math.pi
+    elif chi_R == 0.0:
+        theta = 0.0
+    else:
+        # g ~ theta^2/2 for small theta and g <= theta^2/2: start there and widen.
+        hi = min(0.5 * math.pi, 2.0 * math.sqrt(2.0 * chi_R))
+        while g(hi) < chi_R and hi < 0.5 * math.pi:
+            hi = min(0.5 * math.pi, 2.0 * hi)
+        theta = brentq(lambda x: g(x) - chi_R, 0.0, hi, xtol=_BRENT_XTOL, rtol=_BRENT_RTOL,
+                       maxiter=200)
+    a = R * math.cos(theta) if not strength_limited else 0.0
+    h = sigma_c * R * math.sin(theta) / (2.0 * G)
+    F_contact = 4.0 * sigma_c * R * R * math.cos(theta) * math.sin(theta) if a > 0 else 0.0
+    F_total = 2.0 * sigma_c * R * R * (math.cos(theta) * math.sin(theta) + theta)
+    return dict(a=a, h=h, F_contact=F_contact, F_total=F_total, theta=theta,
+                strength_limited=strength_limited)
+
+
 # (1 + S^2) atan(S) - S = sum_{n>=1} (-1)^(n+1) 2 S^(2n+1) / ((2n-1)(2n+1)).  Below S = 0.5 the
 # direct form would lose ~1/S^2 to cancellation; 30 terms of the series reach 0.25^29 ~ 3e-18
 # relative there.  Coefficients listed from S^3 on, in powers of S^2.

@@ -4,7 +4,7 @@ Layout (names are part of the product):
 
 - root attributes ``schema_version``, ``software``, ``software_version``, ``created``,
   ``scene`` (the full resolved scene as YAML text, so a file reproduces itself), ``complete``;
-- ``history/``: ``t``, ``h``, ``b``, ``gap``, ``F_contact``, ``F_total`` on one time axis
+- ``history/``: ``t``, ``h``, ``a``, ``b``, ``gap``, ``F_contact``, ``F_total`` on one time axis
   (``t`` is attached to the others as their dimension scale), each with a ``unit`` attribute;
 - ``summary`` attributes: the headline numbers at detachment and the run's bookkeeping;
 - ``analytic`` attributes: the closed forms of the seed thesis and the elastic limit;
@@ -26,13 +26,16 @@ from . import __version__
 
 SCHEMA_VERSION = 1
 
-HISTORY_UNITS = {"t": "s", "h": "m", "b": "m", "gap": "m", "F_contact": "N", "F_total": "N"}
+HISTORY_UNITS = {"t": "s", "h": "m", "a": "m", "b": "m", "gap": "m", "F_contact": "N",
+                 "F_total": "N"}
 
 SUMMARY_UNITS = {
     "detached": "", "t_detach": "s", "h_detach": "m", "b_detach": "m", "zone_ratio_detach": "1",
     "F_contact_detach": "N", "F_total_detach": "N", "alpha": "1", "chi": "1", "V": "1",
     "n_elements": "1", "n_steps": "1", "wall_time": "s", "error_estimate": "1",
-    "t_end": "s", "history": "", "notes": "",
+    "t_end": "s", "history": "", "notes": "", "until": "", "cohesive_zone": "",
+    "t_separation": "s", "F_peak_contact": "N", "F_peak_total": "N", "t_peak_contact": "s",
+    "t_peak_total": "s", "observed_order": "1",
 }
 
 ANALYTIC_UNITS = {
@@ -61,6 +64,14 @@ def result_to_record(result, scene_yaml: str) -> dict:
         "t_end": result.t_end,
         "history": result.history_model,
         "notes": "; ".join(result.notes),
+        "until": result.until,
+        "cohesive_zone": result.cohesive_zone,
+        "t_separation": result.t_separation,
+        "F_peak_contact": result.F_peak_contact,
+        "F_peak_total": result.F_peak_total,
+        "t_peak_contact": result.t_peak_contact,
+        "t_peak_total": result.t_peak_total,
+        "observed_order": result.observed_order,
     }
     return {
         "scene": scene_yaml,
@@ -249,9 +260,10 @@ def load(path, history_rows: int | None = None) -> dict:
             "summary": _attrs(f["summary"]),
             "analytic": _attrs(f["analytic"]),
             "history": {name: _read_rows(f["history"][name], history_rows)
-                        for name in HISTORY_UNITS},
+                        for name in HISTORY_UNITS if name in f["history"]},
             "history_rows_in_file": int(f["history"]["t"].shape[0]),
-            "units": {name: str(f["history"][name].attrs["unit"]) for name in HISTORY_UNITS},
+            "units": {name: str(f["history"][name].attrs["unit"]) for name in HISTORY_UNITS
+                      if name in f["history"]},
             "snapshots": [],
         }
         if "snapshots" in f:

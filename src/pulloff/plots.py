@@ -12,13 +12,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def plot_history(record: dict, path, title: str | None = None) -> Path:
-    """Force and gap histories with the closed-form forces marked; saves a PNG at ``path``."""
+    """Force, contact edge and zone end, and gap histories with the closed-form forces
+    marked; saves a PNG at ``path``."""
     h = record["history"]
     s = record["summary"]
     an = record["analytic"]
     t_ms = h["t"] * 1e3
-    fig, (ax_f, ax_g) = plt.subplots(2, 1, figsize=(7.0, 6.4), sharex=True,
-                                     constrained_layout=True)
+    fig, (ax_f, ax_r, ax_g) = plt.subplots(3, 1, figsize=(7.0, 8.4), sharex=True,
+                                           constrained_layout=True)
     ax_f.plot(t_ms, h["F_contact"], label="F_contact (simulation)", color="C0")
     ax_f.plot(t_ms, h["F_total"], label="F_total (simulation)", color="C1", ls="--")
     for key, label, style in (("seed_closed_form_F", "seed closed form", ":"),
@@ -33,6 +34,16 @@ def plot_history(record: dict, path, title: str | None = None) -> Path:
     ax_f.set_ylabel("force [N]")
     ax_f.legend(fontsize=8, loc="upper left")
     ax_f.grid(alpha=0.3)
+
+    if "a" in h:
+        ax_r.plot(t_ms, h["a"] * 1e6, color="C3", label="contact edge a")
+    ax_r.plot(t_ms, h["b"] * 1e6, color="C4", ls="--", label="cohesive-zone end b")
+    if s.get("until") == "separation" and math.isfinite(s.get("F_peak_total", math.nan)):
+        ax_f.plot([s["t_peak_total"] * 1e3], [s["F_peak_total"]], "kv", ms=5,
+                  label="peak F_total")
+    ax_r.set_ylabel("radius [um]")
+    ax_r.legend(fontsize=8, loc="upper left")
+    ax_r.grid(alpha=0.3)
 
     ax_g.plot(t_ms, h["gap"] * 1e9, color="C2", label="gap at r = b")
     delta = _delta(record)

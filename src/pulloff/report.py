@@ -72,6 +72,20 @@ def format_table(record: dict, title: str | None = None) -> str:
         ]
         for label, value, unit, ref in compare:
             lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
+    if s.get("until") == "separation" and record.get("complete", True):
+        lines.append("  past the onset (model.until = separation)")
+        F_on = s["F_total_detach"]
+        rows = [
+            ("separation time", _fmt(s.get("t_separation"), "s")),
+            ("peak F_contact", f"{_fmt(s.get('F_peak_contact'), 'N')} at "
+                               f"{_fmt(s.get('t_peak_contact'), 's')}"),
+            ("peak F_total", f"{_fmt(s.get('F_peak_total'), 'N')} at "
+                             f"{_fmt(s.get('t_peak_total'), 's')}"),
+            ("peak / onset F_total", _rel(s.get("F_peak_total"), F_on)),
+            ("observed order (step)", _fmt(s.get("observed_order"))),
+        ]
+        for label, text in rows:
+            lines.append(f"    {label:<28} {text:>30}")
     for note in filter(None, str(s.get("notes", "")).split("; ")):
         lines.append(f"  note: {note}")
     rows = record.get("history_rows_in_file", len(record["history"]["t"]))

@@ -127,6 +127,9 @@ class Geometry(_Section):
 
     kind: Literal["flat_punch"] = Field(description="punch shape, flat_punch")
     radius: Num = Field(gt=0, description="punch (contact) radius a, m")
+    cohesive_zone: Literal["external", "internal"] = Field(
+        "external", description="cohesive zone outside the punch (the seed's virtual crack) or "
+                                "on its face (b <= radius), no unit")
 
 
 class Material(_Section):
@@ -193,6 +196,9 @@ class Model(_Section):
 
     history: Literal["exact", "frozen"] = Field(
         "exact", description="load history of free elements, exact or frozen (seed eq. 31), no unit")
+    until: Literal["detach", "separation"] = Field(
+        "detach", description="end of the run: the onset (gap(b) = delta) or full separation "
+                              "(the contact edge recedes, then the zone), no unit")
 
 
 class Numerics(_Section):
@@ -248,6 +254,17 @@ class Scene(BaseModel):
                 if value is not None:
                     raise _bad_line(f"numerics.{key} = {_fmt(value)}: nothing is stepped with "
                                     "model.history = frozen (a closed form); remove it")
+        moving_edge = (self.model.until == "separation"
+                       or self.geometry.cohesive_zone == "internal")
+        if moving_edge and self.model.history == "frozen":
+            raise _bad_line("model.history = frozen: the seed's frozen load has no receding "
+                            "contact edge; use history: exact with model.until = separation "
+                            "or geometry.cohesive_zone = internal")
+        if moving_edge and self.numerics.steps is not None:
+            raise _bad_line(f"numerics.steps = {_fmt(self.numerics.steps)}: fixed-step runs "
+                            "cover the seed's onset only; a receding contact edge "
+                            "(model.until = separation, geometry.cohesive_zone = internal) "
+                            "is refined from numerics.rtol")
         if self.numerics.max_elements is not None and self.numerics.steps is None:
             # rtol runs refine every element with the step; a fixed budget would put an
             # error floor under the step-doubling estimate that it cannot see.

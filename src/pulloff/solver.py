@@ -275,6 +275,7 @@ def si_history(problem: "Problem", t, gap) -> dict:
     return {
         "t": t * problem.time_scale,
         "h": problem.lift(t),
+        "a": np.full(np.shape(t), problem.a),
         "b": problem.zone_end(t),
         "gap": gap * problem.delta,
         "F_contact": problem.contact_force(t),
@@ -478,6 +479,14 @@ class Result:
     groups: dict  # alpha, chi, V
     analytic: dict  # closed forms, SI
     history_streamed: bool = False  # the full history went to a stream; ``history`` previews it
+    until: str = "detach"  # model.until
+    cohesive_zone: str = "external"  # geometry.cohesive_zone
+    t_separation: float = math.nan  # s, b reached 0 (model.until = separation)
+    F_peak_contact: float = math.nan  # N, largest F_contact of the run
+    F_peak_total: float = math.nan  # N, largest F_total of the run
+    t_peak_contact: float = math.nan  # s
+    t_peak_total: float = math.nan  # s
+    observed_order: float = math.nan  # of the error with the step, from the last three levels
 
 
 def _n_steps_for(rtol: float) -> int:
@@ -510,6 +519,8 @@ def simulate(scene, progress: bool = False, stream=None) -> Result:
     t_frozen = frozen_detach_time(problem, t_limit)
     snapshot_times = [ts / T for ts in scene.output.snapshots]
 
+    if scene.model.until == "separation" or scene.geometry.cohesive_zone == "internal":
+        return _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_start)
     notes = []
     streamed = False
     if scene.model.history == "frozen":
@@ -772,13 +783,90 @@ def _assemble(scene, problem: Problem, run: FoundationRun, error_estimate: float
     )
 
 
+def _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_start):
+    """A run with a receding contact edge (:mod:`pulloff.propagation`), in SI."""
+    from . import propagation
+
+    rtol = scene.numerics.rtol
+    internal = scene.geometry.cohesive_zone == "internal"
+    until = scene.model.until
+    t_scale = t_frozen if math.isfinite(t_frozen) and t_frozen > 0 else 1.0
+    if not math.isfinite(t_limit):
+        t_limit = propagation.DEFAULT_SPAN * t_scale
+    run, estimate, order = propagation.simulate_levels(problem, rtol, t_scale, t_limit,
+                                                       internal, until, progress)
+    T = problem.time_scale
+    R = problem.a
+    force = problem.sigma_c * R * R
+    notes = []
+    if not estimate <= rtol and not run.interrupted:
+        notes.append(f"not converged: error estimate {estimate:.2g} above rtol {rtol:g} at "
+                     f"the step cap ({propagation.MAX_LEVEL_STEPS} steps per level)")
+    if until == "separation" and math.isnan(run.t_separation) and not run.interrupted:
+        notes.append(f"no separation before t_max = {run.t[-1] * T:.6g} s")
+    rows = _decimate(run.t.size, scene.output.history_rows)
+    t_hist = run.t[rows]
+    history = {
+        "t": t_hist * T,
+        "h": problem.lift(t_hist),
+        "a": R * run.a[rows],
+        "b": R * run.b[rows],
+        "gap": problem.delta * run.gap[rows],
+        "F_contact": force * run.F_contact[rows],
+        "F_total": force * run.F_total[rows],
+    }
+    detached = math.isfinite(run.t_onset)
+    nan = math.nan
+    args = (problem.k, problem.c, problem.h0_scaled, internal)
+    a_on, b_on, F_c_on, F_t_on = propagation.onset_state(run, *args)
+    F_c_on, F_t_on = force * F_c_on, force * F_t_on
+    (t_pc, F_pc), (t_pt, F_pt) = propagation.peaks(run, *args)
+    t_pc, F_pc, t_pt, F_pt = t_pc * T, F_pc * force, t_pt * T, F_pt * force
+    result = Result(
+        problem=problem,
+        history_model=scene.model.history,
+        detached=detached,
+        t_detach=run.t_onset * T if detached else nan,
+        h_detach=float(problem.lift(run.t_onset)) if detached else nan,
+        b_detach=R * b_on if detached else nan,
+        zone_ratio_detach=(b_on - a_on) / a_on if detached and a_on > 0 else nan,
+        F_contact_detach=F_c_on if detached else nan,
+        F_total_detach=F_t_on if detached else nan,
+        error_estimate=float(estimate),
+        complete=not run.interrupted,
+        notes=notes,
+        n_elements=int(run.n_elements),
+        n_steps=int(run.n_steps),
+        wall_time=time.perf_counter() - wall_start,
+        t_end=float(run.t[-1] * T),
+        history=history,
+        snapshots=[],
+        groups=analytic.dimensionless_groups(problem.G, problem.eta, problem.sigma_c,
+                                             problem.delta, problem.a, problem.v),
+        analytic=analytic_predictions(problem, internal),
+        until=until,
+        cohesive_zone=scene.geometry.cohesive_zone,
+        t_separation=run.t_separation * T,
+        F_peak_contact=F_pc,
+        F_peak_total=F_pt,
+        t_peak_contact=t_pc,
+        t_peak_total=t_pt,
+        observed_order=float(order),
+    )
+    return result
+
+
 def _zone_ratio(s):
     """``(b - a)/a = sqrt(1 + s^2) - 1`` without cancellation for thin zones."""
     return s * s / (1.0 + np.sqrt(1.0 + s * s))
 
 
-def analytic_predictions(problem: Problem) -> dict:
-    """The closed forms beside the simulation, SI (nan where a formula does not apply)."""
+def analytic_predictions(problem: Problem, internal: bool = False) -> dict:
+    """The closed forms beside the simulation, SI (nan where a formula does not apply).
+
+    With ``internal`` the elastic MDR-Dugdale forces are those of the zone on the punch face
+    (:func:`pulloff.analytic.elastic_internal_onset`, ``elastic_b`` is then the radius); the
+    seed's forms are for its external zone."""
     p = problem
     out = {}
     lin = analytic.seed_linearised(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v)
@@ -791,7 +879,12 @@ def analytic_predictions(problem: Problem) -> dict:
     gamma = p.sigma_c * p.delta
     out["kendall_F"] = analytic.kendall_force(p.G, gamma, p.a) if p.G > 0 else math.nan
     out["viscous_F"] = analytic.viscous_force(p.eta, p.v, p.a)
-    if p.G > 0:
+    if p.G > 0 and internal:
+        el = analytic.elastic_internal_onset(p.G, p.sigma_c, p.delta, p.a)
+        out["elastic_F_contact"] = el["F_contact"]
+        out["elastic_F_total"] = el["F_total"]
+        out["elastic_b"] = p.a
+    elif p.G > 0:
         el = analytic.elastic_mdr_dugdale(p.G, p.sigma_c, p.delta, p.a)
         out["elastic_F_contact"] = el["F_contact"]
         out["elastic_F_total"] = el["F_total"]
