@@ -55,7 +55,7 @@ def kv_levels():
 def test_kelvin_voigt_crack_grows_at_finite_speed_past_a_higher_peak(kv_levels):
     p, runs = kv_levels
     run = runs[400]
-    outs = propagation.outputs(run, p.k, p.c, p.h0_scaled, False)
+    outs = propagation.outputs(run, False)
     t_on, t_sep, _, F_on, _, F_peak = outs
     assert t_sep > 1.2 * t_on  # finite crack speed: separation well after the onset
     assert F_peak > F_on * (1 + 1e-3)  # measured +6.1 %
@@ -70,7 +70,7 @@ def test_kelvin_voigt_crack_grows_at_finite_speed_past_a_higher_peak(kv_levels):
 
 def test_kelvin_voigt_separation_converges_with_the_step(kv_levels):
     p, runs = kv_levels
-    outs = np.array([propagation.outputs(runs[n], p.k, p.c, p.h0_scaled, False)
+    outs = np.array([propagation.outputs(runs[n], False)
                      for n in (50, 100, 200, 400)])
     diffs = np.abs(np.diff(outs, axis=0))
     orders = np.log2(diffs[-2] / diffs[-1])

@@ -43,6 +43,7 @@ ANALYTIC_UNITS = {
     "seed_closed_form_t_detach": "s", "seed_closed_form_F": "N",
     "seed_closed_form_branch": "", "kendall_F": "N", "viscous_F": "N",
     "elastic_F_contact": "N", "elastic_F_total": "N", "elastic_b": "m",
+    "elastic_instant_F_contact": "N", "elastic_instant_F_total": "N",
 }
 
 

@@ -646,20 +646,45 @@ def edge_integral(xi, U_trial, lo, hi, xi_a, U_a, has_edge_node, xi_b):
 
 
 @njit(cache=True)
-def trial_displacements(U, q_old, lo, hi, xi, xi_b, decay, w_old, w_new, out):
-    """Displacements after one step for a trial zone end ``xi_b`` (into ``out``): the exact
-    exponential update with the load linear over the step. Returns nothing."""
+def trial_displacements(base, lo, hi, xi, xi_b, w_new, out):
+    """Displacements after one step for a trial zone end ``xi_b`` (into ``out``):
+    ``base + w_new q(t + dt)``, the part of the step that does not depend on the new load
+    (``base``) being computed once per step by :func:`kv_base` or :func:`maxwell_base`."""
     for j in range(lo, hi):
-        out[j] = decay * U[j] + w_old * q_old[j] + w_new * zone_load(xi[j], xi_b)
+        out[j] = base[j] + w_new * zone_load(xi[j], xi_b)
 
 
 @njit(cache=True)
-def trial_gap(U, q_old, lo, hi, xi, xi_a, has_edge_node, U_a, xi_b, h, ell, decay, w_old,
-              w_new, scratch):
+def kv_base(U, q_old, lo, hi, decay, w_old, base):
+    """Kelvin-Voigt: ``decay U + w_old q(t)`` of the exact step with the load linear."""
+    for j in range(lo, hi):
+        base[j] = decay * U[j] + w_old * q_old[j]
+
+
+@njit(cache=True)
+def maxwell_base(E, q_old, lo, hi, phi, gamma_old, k_arms, k_total, E_pred, base):
+    """Generalised Maxwell (standard linear solid, Prony series) under a load linear over the
+    step: the dashpot displacements advance as ``E_pred = phi E + gamma_old q(t)`` (plus
+    ``gamma_new q(t + dt)`` once the new load is known), and ``base = k_arms . E_pred /
+    k_total`` is the part of ``U = (q + k_arms . E) / k_total`` that does not depend on it."""
+    m = k_arms.shape[0]
+    for j in range(lo, hi):
+        acc = 0.0
+        for i in range(m):
+            e = gamma_old[i] * q_old[j]
+            for l in range(m):
+                e += phi[i, l] * E[j, l]
+            E_pred[j, i] = e
+            acc += k_arms[i] * e
+        base[j] = acc / k_total
+
+
+@njit(cache=True)
+def trial_gap(base, lo, hi, xi, xi_a, has_edge_node, U_a, xi_b, h, ell, w_new, scratch):
     """Gap at ``r = b`` (units of delta) after one step, for a trial contact edge ``xi_a`` and
     zone end ``xi_b``: ``h - (2/pi) [h asin(a/b) + int_a^b U/sqrt(b^2 - x^2) dx]``, written
     with ``acos(a/b) = atan2(sqrt(b^2 - a^2), a)`` (``ell`` is ``sqrt(b^2 - a^2)``)."""
-    trial_displacements(U, q_old, lo, hi, xi, xi_b, decay, w_old, w_new, scratch)
+    trial_displacements(base, lo, hi, xi, xi_b, w_new, scratch)
     integral = edge_integral(xi, scratch, lo, hi, xi_a, U_a, has_edge_node, xi_b)
     a = 1.0 + xi_a
     return (2.0 / math.pi) * (h * math.atan2(ell, a) - integral)

@@ -50,6 +50,7 @@ class PropagationRun:
     n_steps: int
     interrupted: bool = False
     notes: list = field(default_factory=list)
+    ell_onset: float = math.nan  # sqrt(b^2 - a^2) / R at the onset (bonded line load)
 
 
 def edge_zone_end(xi_a: float, ell: float) -> float:
@@ -77,6 +78,112 @@ def forces(a: float, b: float, ell: float):
     return F_contact, 2.0 * a * ell + 2.0 * b * b * math.atan2(ell, a)
 
 
+class _KelvinVoigt:
+    """``k U + c dU/dt = q`` per element; bonded elements carry ``ell = k h + c``."""
+
+    def __init__(self, problem, capacity):
+        self.k, self.c = problem.k, problem.c
+        self.h0 = problem.h0_scaled
+
+    def start(self, h0):
+        self.ell = self.k * h0 + self.c
+        return self.ell
+
+    def initial_displacement(self, q):
+        # A damper cannot move at once (MODEL.md: u(x, 0) = 0); a spring alone follows q.
+        return q / self.k if self.c == 0.0 else np.zeros_like(q)
+
+    def begin_step(self, dt, h_old, h_new):
+        self.decay, self.w_old, self.w_new = kernels.linear_load_weights(self.k, self.c, dt)
+        self.ell_old, self.ell = self.ell, self.k * h_new + self.c
+        self.h_old = h_old
+        return self.ell
+
+    def base(self, U, E, q_old, lo, hi, out):
+        kernels.kv_base(U, q_old, lo, hi, self.decay, self.w_old, out)
+
+    def commit(self, E, q_new, lo, hi):
+        pass  # U is the whole state
+
+    def released_at_start(self):
+        """``(base, E)`` of an element released at the start of the step (u = h then)."""
+        return self.decay * self.h_old + self.w_old * self.ell_old, None
+
+    def released_now(self):
+        return None  # E of an element released at the end of the step
+
+
+class _Maxwell:
+    """Generalised Maxwell solid ``G(t) = G_inf + sum G_i exp(-t/tau_i)`` (a standard linear
+    solid has one arm): element state = the arms' dashpot displacements ``E_i``.
+
+    Bonded elements all follow the punch, so they share one state; free ones obey
+    ``q = k_inf U + sum k_i (U - E_i)``, ``tau_i dE_i/dt = U - E_i``, a linear system in ``E``
+    driven by ``q``. Its step for ``q`` linear over the step is exact (matrix exponential of
+    the system augmented by the load and its slope), with no stability limit however short
+    the relaxation times.
+    """
+
+    def __init__(self, problem, capacity):
+        from scipy.linalg import expm
+
+        self.expm = expm
+        self.k_inf = problem.k
+        self.k_arms = problem.arm_stiffness
+        self.taus = problem.arm_times
+        self.k_total = self.k_inf + float(np.sum(self.k_arms))
+        m = self.k_arms.size
+        self.E_pred = np.zeros((capacity, m))
+        self.A = (np.outer(1.0 / self.taus, self.k_arms) / self.k_total
+                  - np.diag(1.0 / self.taus))
+        self.B = 1.0 / (self.k_total * self.taus)
+
+    def start(self, h0):
+        self.E_bond = np.zeros(self.k_arms.size)  # the dashpots have not moved at t = 0
+        self.ell = self._bonded(h0)
+        return self.ell
+
+    def _bonded(self, h):
+        return self.k_inf * h + float(np.dot(self.k_arms, h - self.E_bond))
+
+    def initial_displacement(self, q):
+        return q / self.k_total  # the instantaneous (glassy) response
+
+    def begin_step(self, dt, h_old, h_new):
+        m = self.k_arms.size
+        M = np.zeros((m + 2, m + 2))
+        M[:m, :m] = self.A * dt
+        M[:m, m] = self.B * dt
+        M[m, m + 1] = 1.0  # q(t + s dt) = q_old + s (q_new - q_old), s in [0, 1]
+        X = self.expm(M)
+        self.phi = np.ascontiguousarray(X[:m, :m])
+        self.gamma_new = X[:m, m + 1].copy()
+        self.gamma_old = X[:m, m] - self.gamma_new
+        self.w_new = (1.0 + float(np.dot(self.k_arms, self.gamma_new))) / self.k_total
+        # Bonded dashpots under the lift, linear over the step: E + tau dE/dt = h.
+        self.E_bond_old = self.E_bond.copy()
+        for i, tau in enumerate(self.taus):
+            decay, w0, w1 = kernels.linear_load_weights(1.0, tau, dt)
+            self.E_bond[i] = decay * self.E_bond[i] + w0 * h_old + w1 * h_new
+        self.ell_old, self.ell = self.ell, self._bonded(h_new)
+        self.h_old = h_old
+        return self.ell
+
+    def base(self, U, E, q_old, lo, hi, out):
+        kernels.maxwell_base(E, q_old, lo, hi, self.phi, self.gamma_old, self.k_arms,
+                             self.k_total, self.E_pred, out)
+
+    def commit(self, E, q_new, lo, hi):
+        E[lo:hi] = self.E_pred[lo:hi] + np.outer(q_new[lo:hi], self.gamma_new)
+
+    def released_at_start(self):
+        E_pred = self.phi @ self.E_bond_old + self.gamma_old * self.ell_old
+        return float(np.dot(self.k_arms, E_pred)) / self.k_total, E_pred
+
+    def released_now(self):
+        return self.E_bond.copy()
+
+
 def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                     internal: bool = False, until: str = "separation",
                     max_steps: int = 200_000, progress=None) -> PropagationRun:
@@ -91,15 +198,13 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
     every step of the same solution, so the levels of :func:`simulate_propagation` can be
     compared as with a fixed step.
     """
-    k, c, h0 = problem.k, problem.c, problem.h0_scaled
+    h0 = problem.h0_scaled
     n_stop = max_steps
     dt = t_scale / n
-    decay, w_old, w_new = kernels.linear_load_weights(k, c, dt)
-
-    def bonded_load(h):
-        return k * h + c  # Kelvin-Voigt bonded elements at constant speed: ell = k h + c
-
-    ell = bonded_load(h0)
+    n_pre = max(8, n // 4)
+    capacity = n_pre + 2 * (n_stop + 2)
+    law = (_Maxwell if problem.arms else _KelvinVoigt)(problem, capacity)
+    ell = law.start(h0)
     if internal:
         xi_a = edge_contact_for_face(ell)
         xi_b = 0.0
@@ -107,38 +212,37 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
         xi_a = 0.0
         xi_b = edge_zone_end(xi_a, ell)
     # Elements in the zone at t = 0, graded toward b where the load varies fastest.
-    n_pre = max(8, n // 4)
     theta = np.linspace(0.0, 0.5 * math.pi, n_pre)
     xi_pre = xi_a + (xi_b - xi_a) * np.sin(theta)
     xi_pre[-1] = xi_b
-    capacity = n_pre + 2 * (n_stop + 2)
     lo = n_stop + 2
     hi = lo + n_pre
     xi = np.zeros(capacity)
     U = np.zeros(capacity)
+    E = np.zeros((capacity, len(problem.arms)))
     q_old = np.zeros(capacity)
+    base = np.zeros(capacity)
     scratch = np.zeros(capacity)
     xi[lo:hi] = xi_pre
     for j in range(lo, hi):
         q_old[j] = kernels.zone_load(xi[j], xi_b)
-    if c == 0.0:
-        U[lo:hi] = q_old[lo:hi] / k  # an elastic element follows its load at once
+    U[lo:hi] = law.initial_displacement(q_old[lo:hi])
     h = h0
     phase = PHASE_ZONE_ONLY if xi_a <= -1.0 else PHASE_BONDED
 
     def gap_for(xi_a_t, xi_b_t, ell_t, h_t, released, u_edge=None):
         # A node released at the edge holds u = h at its release, the end of the step.
         u_a = h_t if u_edge is None else u_edge
-        return kernels.trial_gap(U, q_old, lo, hi, xi, xi_a_t, released, u_a, xi_b_t, h_t,
-                                 ell_t, decay, w_old, w_new, scratch)
+        return kernels.trial_gap(base, lo, hi, xi, xi_a_t, released, u_a, xi_b_t, h_t,
+                                 ell_t, law.w_new, scratch)
 
     a0 = 1.0 + xi_a
     F_c, F_t = forces(a0, 1.0 + xi_b, ell)
-    g0 = kernels.trial_gap(U, q_old, lo, hi, xi, xi_a, False, h, xi_b, h, ell, 1.0, 0.0,
-                           0.0, scratch)
+    g0 = kernels.trial_gap(U, lo, hi, xi, xi_a, False, h, xi_b, h, ell, 0.0, scratch)
     rows = {"t": [0.0], "h": [h], "a": [a0], "b": [1.0 + xi_b], "gap": [g0],
             "F_contact": [F_c], "F_total": [F_t]}
     t_onset = math.nan
+    ell_onset = math.nan
     t_sep = math.nan
     notes = []
     centre_gap_prev = math.nan
@@ -146,8 +250,9 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
     step = 0
     if g0 >= 1.0:
         t_onset = 0.0
+        ell_onset = ell
         if until == "detach":
-            return _finish(rows, dt, t_onset, t_sep, hi - lo, 0, False, notes)
+            return _finish(rows, dt, t_onset, t_sep, hi - lo, 0, False, notes, ell_onset)
         phase = PHASE_RECEDING
     t_now = 0.0
     rate = 0.0  # |da/dt| + |db/dt| / b_ref of the last step
@@ -157,16 +262,18 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
             # At most doubling per step: the rates come from the step before.
             dt_next = 1.0 / (n * (1.0 / t_scale + rate))
             dt = min(dt_next, 2.0 * dt, t_limit - t_now) if step else min(dt_next, t_limit)
-            decay, w_old, w_new = kernels.linear_load_weights(k, c, dt)
             t_new = t_now + dt
             h_new = h0 + t_new
-            ell_new = bonded_load(h_new)
+            ell_old = law.ell
+            ell_new = law.begin_step(dt, h0 + t_now, h_new)
+            law.base(U, E, q_old, lo, hi, base)
             released = False
             if internal and ell_new >= 1.0 and phase in (PHASE_BONDED, PHASE_RECEDING):
                 # The bonded line load needs a zone wider than the face: the bond is gone.
                 if phase == PHASE_BONDED:
-                    # The strength limit: ell = k h + c reaches the rim at a known time.
-                    t_onset = min(t_new, max(t_now, (1.0 - c) / k - h0)) if k > 0 else t_new
+                    # The strength limit: the bonded load reaches the rim inside this step.
+                    t_onset = t_now + (1.0 - ell_old) / (ell_new - ell_old) * dt
+                    ell_onset = 1.0
                     if until == "detach":
                         break
                 phase = PHASE_ZONE_ONLY
@@ -185,8 +292,9 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                     if phase == PHASE_BONDED:
                         # Onset inside this step: the gap crosses 1 between the last two rows.
                         g_prev = rows["gap"][-1]
-                        t_onset = t_now + (1.0 - g_prev) / (g - g_prev) * dt if g != g_prev \
-                            else t_new
+                        frac = (1.0 - g_prev) / (g - g_prev) if g != g_prev else 1.0
+                        t_onset = t_now + frac * dt
+                        ell_onset = ell_old + frac * (ell_new - ell_old)
                         if until == "detach":
                             break
                         phase = PHASE_RECEDING
@@ -209,15 +317,11 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                 # released at the step's start (u = h then) and loaded since; for an elastic
                 # solid that is its load over k, as it must be.
                 centre_released = released
-                h_start = h0 + t_now
-                ell_start = bonded_load(h_start)
+                centre_base, centre_E = (law.released_at_start() if centre_released
+                                         else (base[lo], None))
 
                 def u_centre(x_b):
-                    if centre_released:
-                        return (decay * h_start + w_old * ell_start
-                                + w_new * kernels.zone_load(-1.0, x_b))
-                    return (decay * U[lo] + w_old * q_old[lo]
-                            + w_new * kernels.zone_load(-1.0, x_b))
+                    return centre_base + law.w_new * kernels.zone_load(-1.0, x_b)
 
                 centre = h_new - u_centre(-1.0) - 1.0  # gap at the centre as the zone vanishes
 
@@ -253,19 +357,28 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                         new_b = brentq(f_b, -1.0, hi_b, xtol=1e-15, rtol=1e-15)
                 ell_new = 0.0
             # Commit the step with the chosen edge and zone end.
-            kernels.trial_displacements(U, q_old, lo, hi, xi, max(new_b, -1.0), decay, w_old,
-                                        w_new, U)
+            kernels.trial_displacements(base, lo, hi, xi, max(new_b, -1.0), law.w_new, U)
             for j in range(lo, hi):
                 q_old[j] = kernels.zone_load(xi[j], new_b)
+            law.commit(E, q_old, lo, hi)
             if released and new_a < xi[lo]:
                 lo -= 1
                 xi[lo] = new_a
-                U[lo] = u_centre(new_b) if phase >= PHASE_ZONE_ONLY else h_new
                 q_old[lo] = kernels.zone_load(new_a, new_b)
+                if phase >= PHASE_ZONE_ONLY:
+                    U[lo] = u_centre(new_b)
+                    if centre_E is not None:
+                        E[lo] = centre_E + law.gamma_new * q_old[lo]
+                else:
+                    U[lo] = h_new
+                    E_now = law.released_now()
+                    if E_now is not None:
+                        E[lo] = E_now
             if new_b > xi[hi - 1]:
                 xi[hi] = new_b
-                U[hi] = 0.0
+                U[hi] = 0.0  # enters now, unloaded: its dashpots have not moved either
                 q_old[hi] = 0.0
+                E[hi] = 0.0
                 hi += 1
             rate = (abs(new_a - xi_a) + abs(max(new_b, -1.0) - xi_b) / b_ref) / dt
             xi_a, xi_b = new_a, new_b
@@ -285,14 +398,14 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                 progress(1)
     except KeyboardInterrupt:
         interrupted = True
-    return _finish(rows, dt, t_onset, t_sep, hi - lo, step, interrupted, notes)
+    return _finish(rows, dt, t_onset, t_sep, hi - lo, step, interrupted, notes, ell_onset)
 
 
-def _finish(rows, dt, t_onset, t_sep, n_elements, n_steps, interrupted, notes):
+def _finish(rows, dt, t_onset, t_sep, n_elements, n_steps, interrupted, notes, ell_onset):
     arrays = {name: np.asarray(values, dtype=float) for name, values in rows.items()}
     return PropagationRun(dt, arrays["t"], arrays["h"], arrays["a"], arrays["b"], arrays["gap"],
                           arrays["F_contact"], arrays["F_total"], t_onset, t_sep, n_elements,
-                          n_steps, interrupted, notes)
+                          n_steps, interrupted, notes, ell_onset)
 
 
 # --------------------------------------------------------------------------------------------
@@ -324,12 +437,12 @@ def peak(t: np.ndarray, F: np.ndarray):
     return float(t[i]), float(F[i])
 
 
-def onset_state(run: PropagationRun, k: float, c: float, h0: float, internal: bool):
-    """``(a, b, F_contact, F_total)`` at the onset time (the edge condition at the onset
-    lift with the contact radius of the step it falls in); nans without an onset."""
+def onset_state(run: PropagationRun, internal: bool):
+    """``(a, b, F_contact, F_total)`` at the onset time (the edge condition with the bonded
+    load at the onset and the contact radius of the step it falls in); nans without one."""
     if not math.isfinite(run.t_onset):
         return (math.nan,) * 4
-    ell = k * (h0 + run.t_onset) + c
+    ell = run.ell_onset
     if internal:
         a = 1.0 + edge_contact_for_face(ell)
         b = 1.0
@@ -340,10 +453,10 @@ def onset_state(run: PropagationRun, k: float, c: float, h0: float, internal: bo
     return (a, b, *forces(a, b, ell))
 
 
-def peaks(run: PropagationRun, k, c, h0, internal):
+def peaks(run: PropagationRun, internal: bool):
     """``((t, F_contact), (t, F_total))`` of the largest forces, the onset included (an
     unstable crack's largest force is at the onset, between two samples)."""
-    _, _, Fc_on, Ft_on = onset_state(run, k, c, h0, internal)
+    _, _, Fc_on, Ft_on = onset_state(run, internal)
     out = []
     for F, F_on in ((run.F_contact, Fc_on), (run.F_total, Ft_on)):
         t_p, F_p = peak(run.t, F)
@@ -353,10 +466,10 @@ def peaks(run: PropagationRun, k, c, h0, internal):
     return out
 
 
-def outputs(run: PropagationRun, k, c, h0, internal) -> np.ndarray:
+def outputs(run: PropagationRun, internal: bool) -> np.ndarray:
     """The numbers a level is judged by: onset and separation times, onset and peak forces."""
-    _, _, Fc_on, Ft_on = onset_state(run, k, c, h0, internal)
-    (_, Fc), (_, Ft) = peaks(run, k, c, h0, internal)
+    _, _, Fc_on, Ft_on = onset_state(run, internal)
+    (_, Fc), (_, Ft) = peaks(run, internal)
     return np.array([run.t_onset, run.t_separation, Fc_on, Ft_on, Fc, Ft], dtype=float)
 
 
@@ -369,7 +482,7 @@ def simulate_levels(problem, rtol: float, t_scale: float, t_limit: float, intern
     levels = []
     n = 50
     estimate, order = math.nan, math.nan
-    args = (problem.k, problem.c, problem.h0_scaled, internal)
+    args = (internal,)
     while True:
         bar = None
         if progress:

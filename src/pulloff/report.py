@@ -70,6 +70,10 @@ def format_table(record: dict, title: str | None = None) -> str:
             ("elastic MDR-Dugdale F_total", an.get("elastic_F_total"), "N",
              s["F_total_detach"]),
         ]
+        instant = an.get("elastic_instant_F_total")
+        if isinstance(instant, float) and math.isfinite(instant):
+            compare.append(("elastic, instantaneous modulus F_total", instant, "N",
+                            s["F_total_detach"]))
         for label, value, unit, ref in compare:
             lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
     if s.get("until") == "separation" and record.get("complete", True):

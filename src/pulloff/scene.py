@@ -132,19 +132,66 @@ class Geometry(_Section):
                                 "on its face (b <= radius), no unit")
 
 
-class Material(_Section):
-    """Incompressible Kelvin-Voigt half-space: shear modulus G in parallel with viscosity eta."""
+class PronyTerm(_Section):
+    """One Maxwell arm of a Prony series: a spring G in series with a damper G tau."""
 
-    kind: Literal["kelvin_voigt"] = Field(description="rheology, kelvin_voigt")
-    G: Num = Field(ge=0, description="shear modulus, Pa")
-    eta: Num = Field(ge=0, description="shear viscosity, Pa s")
+    G: Num = Field(gt=0, description="shear modulus of the arm, Pa")
+    tau: Num = Field(gt=0, description="relaxation time of the arm, s")
+
+
+#: The parameters each rheology takes (MODEL.md section 6: G(t) = G_inf + sum G_i e^(-t/tau_i),
+#: Kelvin-Voigt G + eta delta(t)).
+_MATERIAL_KEYS = {
+    "elastic": ("G",),
+    "kelvin_voigt": ("G", "eta"),
+    "standard_linear_solid": ("G_inf", "G_1", "tau_1"),
+    "prony": ("G_inf", "terms"),
+}
+
+
+class Material(_Section):
+    """Incompressible linear viscoelastic half-space; which parameters it takes depends on
+    ``kind``: elastic (G), kelvin_voigt (G, eta), standard_linear_solid (G_inf, G_1, tau_1),
+    prony (G_inf and terms, a list of {G, tau})."""
+
+    kind: Literal["elastic", "kelvin_voigt", "standard_linear_solid", "prony"] = Field(
+        description="rheology: elastic, kelvin_voigt, standard_linear_solid or prony")
+    G: Optional[Num] = Field(None, ge=0, description="shear modulus, Pa")
+    eta: Optional[Num] = Field(None, ge=0, description="shear viscosity, Pa s")
+    G_inf: Optional[Num] = Field(None, gt=0, description="relaxed (long-time) shear modulus, Pa")
+    G_1: Optional[Num] = Field(None, gt=0, description="shear modulus of the Maxwell arm, Pa")
+    tau_1: Optional[Num] = Field(None, gt=0, description="relaxation time of the Maxwell arm, s")
+    terms: Optional[list[PronyTerm]] = Field(
+        None, min_length=1, description="Maxwell arms of the Prony series, list of {G, tau}")
 
     @model_validator(mode="after")
-    def _not_both_zero(self) -> Material:
-        if self.G == 0 and self.eta == 0:
+    def _parameters_of_kind(self) -> Material:
+        wanted = _MATERIAL_KEYS[self.kind]
+        missing = [key for key in wanted if getattr(self, key) is None]
+        if missing:
+            raise _bad_line(", ".join("{p}" + key for key in missing) + f": missing (kind "
+                            f"{self.kind} takes {', '.join(wanted)})")
+        for key in ("G", "eta", "G_inf", "G_1", "tau_1", "terms"):
+            if key not in wanted and getattr(self, key) is not None:
+                raise _bad_line(f"{{p}}{key} = {_fmt(getattr(self, key))}: not a parameter of "
+                                f"kind {self.kind} (it takes {', '.join(wanted)})")
+        if self.kind == "kelvin_voigt" and self.G == 0 and self.eta == 0:
             raise _bad_line("{p}G = 0.0, {p}eta = 0.0: both zero "
                             "(need G > 0 or eta > 0; a half-space with neither has no stiffness)")
+        if self.kind == "elastic" and self.G == 0:
+            raise _bad_line("{p}G = 0.0: an elastic half-space needs G > 0")
         return self
+
+    def relaxation(self):
+        """``(G_inf [Pa], eta [Pa s], arms [(G_i [Pa], tau_i [s])])`` of
+        ``G(t) = G_inf + eta delta(t) + sum_i G_i exp(-t / tau_i)``."""
+        if self.kind == "elastic":
+            return self.G, 0.0, ()
+        if self.kind == "kelvin_voigt":
+            return self.G, self.eta, ()
+        if self.kind == "standard_linear_solid":
+            return self.G_inf, 0.0, ((self.G_1, self.tau_1),)
+        return self.G_inf, 0.0, tuple((term.G, term.tau) for term in self.terms)
 
 
 class Adhesion(_Section):
@@ -432,8 +479,11 @@ def load_scene(path: str | Path, overrides: Sequence[str] = ()) -> Scene:
 
 def scene_to_yaml(scene: Scene) -> str:
     """The full resolved scene (defaults filled, all three adhesion values) as YAML text."""
-    return yaml.dump(scene.model_dump(by_alias=True), Dumper=_SceneDumper,
-                     sort_keys=False, default_flow_style=False, allow_unicode=True)
+    data = scene.model_dump(by_alias=True)
+    # A rheology's file names only its own parameters.
+    data["material"] = {k: v for k, v in data["material"].items() if v is not None}
+    return yaml.dump(data, Dumper=_SceneDumper, sort_keys=False, default_flow_style=False,
+                     allow_unicode=True)
 
 
 def group_values(alpha: float, chi: float, G: float = 1e6, sigma_c: float = 1e6,

@@ -43,12 +43,26 @@ class Problem:
     a: float  # m
     v: float  # m/s
     h0: float = 0.0  # m
+    #: Maxwell arms ``((G_i [Pa], tau_i [s]), ...)`` of a standard linear solid or Prony
+    #: series; ``G`` is then the relaxed modulus ``G_inf`` and ``eta`` is 0.
+    arms: tuple = ()
 
     @classmethod
     def from_scene(cls, scene) -> "Problem":
-        return cls(G=scene.material.G, eta=scene.material.eta, sigma_c=scene.adhesion.sigma_c,
-                   delta=scene.adhesion.delta, a=scene.geometry.radius, v=scene.loading.v,
-                   h0=scene.loading.h0)
+        G, eta, arms = scene.material.relaxation()
+        return cls(G=G, eta=eta, sigma_c=scene.adhesion.sigma_c, delta=scene.adhesion.delta,
+                   a=scene.geometry.radius, v=scene.loading.v, h0=scene.loading.h0,
+                   arms=tuple(arms))
+
+    @property
+    def arm_stiffness(self) -> np.ndarray:
+        """Dimensionless ``k_i = 2 G_i delta / (sigma_c a)`` of the Maxwell arms."""
+        return np.array([2.0 * G * self.delta / (self.sigma_c * self.a) for G, _ in self.arms])
+
+    @property
+    def arm_times(self) -> np.ndarray:
+        """Dimensionless relaxation times ``tau_i v / delta`` of the Maxwell arms."""
+        return np.array([tau / self.time_scale for _, tau in self.arms])
 
     @property
     def k(self) -> float:
@@ -370,8 +384,8 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
                 row0 = step
                 step_new, n_born, code = kernels.march(
                     sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
-                    dx_born, thin_w, n_born, j_consecutive, step, min(stop, row0 + buffer), k, c, h0, dt, *weights, t_buf,
-                    gap_buf, row0)
+                    dx_born, thin_w, n_born, j_consecutive, step, min(stop, row0 + buffer), k,
+                    c, h0, dt, *weights, t_buf, gap_buf, row0)
                 rows = step_new - row0
                 history.add(np.arange(row0 + 1, step_new + 1), t_buf[1:rows + 1].copy(),
                             gap_buf[1:rows + 1].copy())
@@ -519,7 +533,8 @@ def simulate(scene, progress: bool = False, stream=None) -> Result:
     t_frozen = frozen_detach_time(problem, t_limit)
     snapshot_times = [ts / T for ts in scene.output.snapshots]
 
-    if scene.model.until == "separation" or scene.geometry.cohesive_zone == "internal":
+    if (scene.model.until == "separation" or scene.geometry.cohesive_zone == "internal"
+            or problem.arms):
         return _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_start)
     notes = []
     streamed = False
@@ -817,7 +832,7 @@ def _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_star
     }
     detached = math.isfinite(run.t_onset)
     nan = math.nan
-    args = (problem.k, problem.c, problem.h0_scaled, internal)
+    args = (internal,)
     a_on, b_on, F_c_on, F_t_on = propagation.onset_state(run, *args)
     F_c_on, F_t_on = force * F_c_on, force * F_t_on
     (t_pc, F_pc), (t_pt, F_pt) = propagation.peaks(run, *args)
@@ -891,4 +906,13 @@ def analytic_predictions(problem: Problem, internal: bool = False) -> dict:
         out["elastic_b"] = el["b"]
     else:
         out["elastic_F_contact"] = out["elastic_F_total"] = out["elastic_b"] = math.nan
+    # A standard linear solid or Prony series: the elastic forms are those of the relaxed
+    # modulus; beside them, the instantaneous modulus's (a pull much faster than every tau).
+    out["elastic_instant_F_contact"] = out["elastic_instant_F_total"] = math.nan
+    if p.arms:
+        G0 = p.G + sum(G for G, _ in p.arms)
+        el = (analytic.elastic_internal_onset(G0, p.sigma_c, p.delta, p.a) if internal
+              else analytic.elastic_mdr_dugdale(G0, p.sigma_c, p.delta, p.a))
+        out["elastic_instant_F_contact"] = el["F_contact"]
+        out["elastic_instant_F_total"] = el["F_total"]
     return out
