@@ -78,7 +78,8 @@ def long_run(steps: int, lines: list) -> None:
     s = record["summary"]
     p = Problem.from_scene(load_scene(SEED))
     ref = reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=1e-12)
-    err = max(abs(s["t_detach"] / ref["t_detach"] - 1), abs(s["F_total_detach"] / ref["F_total"] - 1))
+    err = max(abs(s["t_detach"] / ref["t_detach"] - 1),
+              abs(s["F_total_detach"] / ref["F_total"] - 1))
     lines += [
         f"== long run: seed_flat_punch, numerics.steps = {steps:.3g}, max_elements = 1024, "
         f"output.every = 1",

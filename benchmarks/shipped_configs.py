@@ -29,7 +29,7 @@ def main() -> None:
     t0 = time.perf_counter()
     simulate(load_scene(CONFIGS / "seed_flat_punch.yaml"))
     print(f"first call (JIT compile or cache load): {time.perf_counter() - t0:.2f} s")
-    header = (f"{'config':<18} {'history':<7} {'F_contact [N]':>14} {'vs closed form':>14} "
+    header = (f"{'config':<22} {'history':<7} {'F_contact [N]':>14} {'vs closed form':>14} "
               f"{'error':>9} {'estimate':>9} {'steps':>6} {'median ms':>10} {'min-max ms':>14}")
     print(header)
     for path in sorted(CONFIGS.glob("*.yaml")):
@@ -40,7 +40,13 @@ def main() -> None:
             res = simulate(scene)
             times.append(1e3 * (time.perf_counter() - start))
         p = res.problem
-        if scene.model.history == "exact":
+        # The quadrature reference solves the seed's model: Kelvin-Voigt (or elastic) on the
+        # external zone, up to the onset, which a run to separation also reports.
+        seed_model = (scene.geometry.cohesive_zone == "external"
+                      and scene.material.kind in ("kelvin_voigt", "elastic"))
+        if scene.model.history == "exact" and not seed_model:
+            error_text = f"{'-':>9}"
+        elif scene.model.history == "exact":
             ref = reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0,
                                        rtol=1e-11)
             error = max(abs(res.t_detach / ref["t_detach"] - 1),
@@ -51,7 +57,7 @@ def main() -> None:
             error_text = f"{'(closed)':>9}"
         closed = res.analytic["seed_closed_form_F"]
         diff = (closed - res.F_contact_detach) / res.F_contact_detach
-        print(f"{path.stem:<18} {scene.model.history:<7} {res.F_contact_detach:14.6g} "
+        print(f"{path.stem:<22} {scene.model.history:<7} {res.F_contact_detach:14.6g} "
               f"{diff:+14.2%} {error_text} {res.error_estimate:9.1e} {res.n_steps:6d} "
               f"{statistics.median(times):10.2f} {min(times):6.2f}-{max(times):<7.2f}")
 

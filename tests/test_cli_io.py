@@ -157,3 +157,10 @@ def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypa
     assert rec["history"]["gap"][-1] < 1e-8  # cut before detachment
     assert main(["show", str(out)]) == 0
     assert "INCOMPLETE" in capsys.readouterr().out
+
+
+def test_cli_run_without_a_plot(tmp_path):
+    out = tmp_path / "quiet.h5"
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot"]) == 0
+    assert out.exists() and not out.with_suffix(".png").exists()
+    assert h5io.load(out)["summary"]["detached"]

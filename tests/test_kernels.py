@@ -240,7 +240,8 @@ def test_thin_entered_keeps_young_and_oldest_and_grades_the_rest():
     x = np.concatenate([[0.0], np.cumsum(dx[1:kept])])
     for j in range(1, kept - 1):
         if born[j] - born[j - 1] > 1:
-            for poly in ([1.0], [0.3, -2.0], [0.1, 0.5, -1.0], [2.0, 0.0, 0.0, 1.5][: 4 if j > 1 else 3]):
+            cubic = [2.0, 0.0, 0.0, 1.5] if j > 1 else [2.0, 0.0, 1.5]  # quadratic at j = 1
+            for poly in ([1.0], [0.3, -2.0], [0.1, 0.5, -1.0], cubic):
                 f = np.polynomial.Polynomial(poly)
                 exact = f.integ()(x[j]) - f.integ()(x[j - 1])
                 nodes = f(x[max(j - 2, 0):j + 2]) if j > 1 else np.concatenate([[0.0], f(x[0:3])])

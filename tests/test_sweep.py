@@ -157,3 +157,17 @@ def test_python_api_needs_no_files(tmp_path):
     assert res.detached
     table = pulloff.sweep(scene, ["loading.v=1e-3,1e-2"], workers=1).table
     assert table["F_contact"][0] == pytest.approx(res.F_contact_detach, rel=1e-3)
+
+
+def test_a_sweep_file_without_its_layout_is_a_clear_error(tmp_path):
+    import h5py
+
+    from pulloff import h5io
+    from pulloff.sweeps import SweepError, load_sweep
+
+    path = tmp_path / "old.h5"
+    with h5py.File(path, "w") as f:
+        h5io.stamp(f)
+        f.attrs["kind"] = "sweep"
+    with pytest.raises(SweepError, match=r"old\.h5: a sweep file without axes, points"):
+        load_sweep(path)

@@ -11,7 +11,7 @@ from . import __version__
 
 
 def _cmd_run(args) -> int:
-    from . import h5io, plots, report, scene as scene_mod, solver
+    from . import h5io, report, scene as scene_mod, solver
 
     scene = scene_mod.load_scene(args.config, overrides=args.set or ())
     out = Path(args.output) if args.output else None
@@ -29,10 +29,15 @@ def _cmd_run(args) -> int:
         h5io.fill(f, record, history_streamed=result.history_streamed)
         if stream is not None:
             record["history_rows_in_file"] = stream.rows
-    png = out.with_suffix(".png")
-    plots.plot_history(record, png, title=scene.name or Path(args.config).stem)
     print(report.format_table(record, title=f"{scene.name or args.config}"))
-    print(f"  wrote {out} and {png}")
+    if args.no_plot:
+        print(f"  wrote {out}")
+    else:
+        from . import plots
+
+        png = out.with_suffix(".png")
+        plots.plot_history(record, png, title=scene.name or Path(args.config).stem)
+        print(f"  wrote {out} and {png}")
     if not result.complete:
         print("  interrupted: the file holds the history computed so far and is marked "
               "complete = False", file=sys.stderr)
@@ -129,6 +134,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
                      help="override a scene value; repeatable")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    run.add_argument("--no-plot", action="store_true",
+                     help="write no PNG (and load no plotting library): batch and long runs")
     run.set_defaults(func=_cmd_run)
 
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameters, one row each")

@@ -517,7 +517,8 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
     always fall on step boundaries (see :func:`displacement_integral` for ``dx_pre``/
     ``dx_born``). ``t_out``/``gap_out`` receive the time and gap after each step at row
     ``step - row0`` and must reach ``step_stop - row0``. Elements from ``j_consecutive`` on
-    were born on consecutive steps (thinning only removes older ones). Returns ``(step, n_born, code)``:
+    were born on consecutive steps (thinning only removes older ones). Returns
+    ``(step, n_born, code)``:
     ``MARCH_CROSSED`` when the gap reached 1, ``MARCH_FULL`` when the element arrays are full
     (thin them with :func:`thin_entered` and call again), ``MARCH_STOPPED`` at ``step_stop``.
     """

@@ -5,7 +5,8 @@ and gap in ``delta``, time in ``delta / v``; ``k``, ``c`` as there), but the fou
 fixed positions in ``x`` because the contact edge ``a`` moves. Each step:
 
 1. the bonded line load gives ``ell = sqrt(b^2 - a^2)`` (edge condition; ``k h + c`` for a
-   Kelvin-Voigt solid lifted at constant speed);
+   Kelvin-Voigt solid lifted at constant speed, from the shared state of the bonded elements
+   for a Maxwell solid);
 2. the contact edge is tried where it was (external zone) or where the edge condition puts it
    with ``b = R`` (internal zone, the zone on the punch face);
 3. if the gap at ``b`` then exceeds ``delta``, the edge recedes: ``a`` solves ``gap(b(a)) =
@@ -13,10 +14,11 @@ fixed positions in ``x`` because the contact edge ``a`` moves. Each step:
    ``u = h`` and continue as free elements. Once ``a = 0`` the zone alone holds the punch:
    ``b`` solves ``gap(b) = delta``, until the gap at the centre reaches ``delta`` (separation).
 
-Free elements advance by the exact exponential step with the load linear over the step; the
-gap integral is a product integration of the piecewise-linear field against
-``1/sqrt(b^2 - x^2)``. A new element is placed at ``a`` and at ``b`` whenever they move, so
-both edges are resolved between the old nodes, not snapped to them.
+Free elements advance by the exact step of their rheology for a load linear over the step
+(Kelvin-Voigt: an exponential; a standard linear solid or Prony series: the matrix exponential
+of its arms). The gap integral integrates the field, linear in ``sqrt(b^2 - x^2)`` between
+nodes, exactly against ``1/sqrt(b^2 - x^2)``. A new element is placed at ``a`` and at ``b``
+whenever they move, so both edges are resolved between the old nodes, not snapped to them.
 """
 
 from __future__ import annotations
@@ -194,9 +196,8 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
     The step follows the physics: each step advances ``1/n`` of a measure that adds the time
     in units of ``t_scale`` (the onset time, say) to the distances the contact edge and the
     zone end travel (in ``R`` and in the initial zone end), predicted from the last step's
-    rates. Doubling ``n`` halves
-    every step of the same solution, so the levels of :func:`simulate_propagation` can be
-    compared as with a fixed step.
+    rates. Doubling ``n`` halves every step of the same solution, so the levels of
+    :func:`simulate_levels` can be compared as with a fixed step.
     """
     h0 = problem.h0_scaled
     n_stop = max_steps
@@ -248,7 +249,14 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
     centre_gap_prev = math.nan
     interrupted = False
     step = 0
-    if g0 >= 1.0:
+    if phase == PHASE_ZONE_ONLY:
+        # The bonded load needs more than the face at once (internal zone): the bond is gone
+        # at t = 0, the punch hangs on the zone at the strength limit.
+        t_onset = 0.0
+        ell_onset = ell
+        if until == "detach":
+            return _finish(rows, dt, t_onset, t_sep, hi - lo, 0, False, notes, ell_onset)
+    elif g0 >= 1.0:
         t_onset = 0.0
         ell_onset = ell
         if until == "detach":

@@ -403,6 +403,11 @@ def _read_rows(f) -> dict:
 
 
 def _layout_of(f) -> _Layout:
+    missing = [name for name in ("axes", "points", "base_scene", "keys") if name not in f.attrs]
+    if missing:
+        # A sweep file of an older layout (or a damaged one): say so instead of a KeyError.
+        raise SweepError(f"{f.filename}: a sweep file without {', '.join(missing)} (written by "
+                         f"an older pulloff?); choose another -o or remove the file")
     axes = [Axis(a["key"], tuple(a["values"])) for a in json.loads(f.attrs["axes"])]
     points = [tuple(p) for p in json.loads(f.attrs["points"])]
     return _Layout(str(f.attrs["base_scene"]), json.loads(f.attrs["keys"]), points, axes)
