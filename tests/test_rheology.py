@@ -115,8 +115,8 @@ def test_maxwell_element_step_is_exact_for_a_linear_load(dt):
     p = Problem(G=1e6, eta=0.0, sigma_c=1e6, delta=1e-6, a=1e-3, v=1e-3,
                 arms=((2e6, 1e-4), (5e5, 7e-3), (3e6, 0.2)))
     law = _Maxwell(p, 4)
-    law.start(0.0)
-    law.begin_step(dt, 0.0, dt)
+    law.start(0.0, True)
+    law.prepare(dt)
     E0 = np.array([0.3, -0.1, 0.05])
     q0, q1 = 0.7, 1.9
     E = np.zeros((1, 3))

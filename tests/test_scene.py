@@ -141,7 +141,7 @@ REJECT = [
     ("material.kind=maxwell", "material.kind", "'maxwell'", "must be one of"),
     ("model.history=lazy", "model.history", "'lazy'", "must be one of"),
     ("material=5", "material", "5", "mapping"),
-    ("loading.speed=1e-3", "loading.speed", "1e-3", "unknown key (allowed: kind, v, h0)"),
+    ("loading.speed=1e-3", "loading.speed", "1e-3", "unknown key (allowed: kind, v, h0, machine_stiffness)"),
     ("colour=red", "colour", "'red'", "unknown key"),
     ("adhesion.gamma=0.06", "adhesion.gamma", "0.06", "inconsistent"),
 ]

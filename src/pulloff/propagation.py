@@ -81,25 +81,41 @@ def forces(a: float, b: float, ell: float):
 
 
 class _KelvinVoigt:
-    """``k U + c dU/dt = q`` per element; bonded elements carry ``ell = k h + c``."""
+    """``k U + c dU/dt = q`` per element; bonded elements carry ``ell = k h + c dh/dt``.
+
+    The punch speed (in units of ``v``) is 1 under a rigid machine. Behind a spring it follows
+    from the force balance; over a step it is advanced by the trapezoidal rule, which keeps the
+    bonded load second order and reproduces the rigid case exactly.
+    """
 
     def __init__(self, problem, capacity):
         self.k, self.c = problem.k, problem.c
-        self.h0 = problem.h0_scaled
 
-    def start(self, h0):
-        self.ell = self.k * h0 + self.c
+    def start(self, h0, rigid):
+        self.speed = 1.0 if rigid else 0.0  # behind a relaxed spring the punch starts at rest
+        self.ell = self.k * h0 + self.c * self.speed
         return self.ell
 
     def initial_displacement(self, q):
         # A damper cannot move at once (MODEL.md: u(x, 0) = 0); a spring alone follows q.
         return q / self.k if self.c == 0.0 else np.zeros_like(q)
 
-    def begin_step(self, dt, h_old, h_new):
+    def prepare(self, dt):
+        self.dt = dt
         self.decay, self.w_old, self.w_new = kernels.linear_load_weights(self.k, self.c, dt)
-        self.ell_old, self.ell = self.ell, self.k * h_new + self.c
-        self.h_old = h_old
-        return self.ell
+
+    def _speed(self, h_old, h_new):
+        return 2.0 * (h_new - h_old) / self.dt - self.speed
+
+    def bonded_trial(self, h_old, h_new):
+        """Bonded line load at the end of the step for a trial lift (no state changes)."""
+        if self.c == 0.0:
+            return self.k * h_new
+        return self.k * h_new + self.c * self._speed(h_old, h_new)
+
+    def advance_bonded(self, h_old, h_new):
+        self.ell = self.bonded_trial(h_old, h_new)
+        self.speed = self._speed(h_old, h_new)
 
     def base(self, U, E, q_old, lo, hi, out):
         kernels.kv_base(U, q_old, lo, hi, self.decay, self.w_old, out)
@@ -107,12 +123,15 @@ class _KelvinVoigt:
     def commit(self, E, q_new, lo, hi):
         pass  # U is the whole state
 
-    def released_at_start(self):
+    def released_at_start(self, h_old):
         """``(base, E)`` of an element released at the start of the step (u = h then)."""
-        return self.decay * self.h_old + self.w_old * self.ell_old, None
+        return self.decay * h_old + self.w_old * self.ell, None
 
     def released_now(self):
         return None  # E of an element released at the end of the step
+
+    def with_load(self, E_pred, q):
+        return None
 
 
 class _Maxwell:
@@ -140,18 +159,15 @@ class _Maxwell:
                   - np.diag(1.0 / self.taus))
         self.B = 1.0 / (self.k_total * self.taus)
 
-    def start(self, h0):
+    def start(self, h0, rigid):
         self.E_bond = np.zeros(self.k_arms.size)  # the dashpots have not moved at t = 0
-        self.ell = self._bonded(h0)
+        self.ell = self.k_inf * h0 + float(np.dot(self.k_arms, h0 - self.E_bond))
         return self.ell
-
-    def _bonded(self, h):
-        return self.k_inf * h + float(np.dot(self.k_arms, h - self.E_bond))
 
     def initial_displacement(self, q):
         return q / self.k_total  # the instantaneous (glassy) response
 
-    def begin_step(self, dt, h_old, h_new):
+    def prepare(self, dt):
         m = self.k_arms.size
         M = np.zeros((m + 2, m + 2))
         M[:m, :m] = self.A * dt
@@ -162,14 +178,21 @@ class _Maxwell:
         self.gamma_new = X[:m, m + 1].copy()
         self.gamma_old = X[:m, m] - self.gamma_new
         self.w_new = (1.0 + float(np.dot(self.k_arms, self.gamma_new))) / self.k_total
-        # Bonded dashpots under the lift, linear over the step: E + tau dE/dt = h.
-        self.E_bond_old = self.E_bond.copy()
-        for i, tau in enumerate(self.taus):
-            decay, w0, w1 = kernels.linear_load_weights(1.0, tau, dt)
-            self.E_bond[i] = decay * self.E_bond[i] + w0 * h_old + w1 * h_new
-        self.ell_old, self.ell = self.ell, self._bonded(h_new)
-        self.h_old = h_old
-        return self.ell
+        # Bonded dashpots under a lift linear over the step: E + tau dE/dt = h.
+        self.bond_weights = np.array([kernels.linear_load_weights(1.0, tau, dt)
+                                      for tau in self.taus])
+
+    def _bond_after(self, h_old, h_new):
+        w = self.bond_weights
+        return w[:, 0] * self.E_bond + w[:, 1] * h_old + w[:, 2] * h_new
+
+    def bonded_trial(self, h_old, h_new):
+        E = self._bond_after(h_old, h_new)
+        return self.k_inf * h_new + float(np.dot(self.k_arms, h_new - E))
+
+    def advance_bonded(self, h_old, h_new):
+        self.ell = self.bonded_trial(h_old, h_new)
+        self.E_bond = self._bond_after(h_old, h_new)
 
     def base(self, U, E, q_old, lo, hi, out):
         kernels.maxwell_base(E, q_old, lo, hi, self.phi, self.gamma_old, self.k_arms,
@@ -178,26 +201,55 @@ class _Maxwell:
     def commit(self, E, q_new, lo, hi):
         E[lo:hi] = self.E_pred[lo:hi] + np.outer(q_new[lo:hi], self.gamma_new)
 
-    def released_at_start(self):
-        E_pred = self.phi @ self.E_bond_old + self.gamma_old * self.ell_old
+    def released_at_start(self, h_old):
+        E_pred = self.phi @ self.E_bond + self.gamma_old * self.ell
         return float(np.dot(self.k_arms, E_pred)) / self.k_total, E_pred
 
     def released_now(self):
         return self.E_bond.copy()
 
+    def with_load(self, E_pred, q):
+        return E_pred + self.gamma_new * q
+
+
+@dataclass
+class _Attempt:
+    """The edges, forces and events of one step for a trial lift (nothing committed)."""
+
+    h: float
+    ell: float
+    phase: int
+    new_a: float
+    new_b: float
+    released: bool
+    gap: float
+    F_contact: float
+    F_total: float
+    onset_frac: float = math.nan  # where in the step the onset falls (nan: not in this step)
+    ell_onset: float = math.nan
+    sep_time: float = math.nan
+    centre_base: float = math.nan
+    centre_E: object = None
+    centre_gap: float = math.nan
+    stop: bool = False  # the onset, and the run ends there (until = detach)
+    valid: bool = True  # False: no zone end satisfies gap(b) = delta at this lift
+
 
 def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                     internal: bool = False, until: str = "separation",
-                    max_steps: int = 200_000, progress=None) -> PropagationRun:
+                    max_steps: int = 200_000, progress=None,
+                    machine: float | None = None) -> PropagationRun:
     """Step the foundation until separation (or the onset, ``until = 'detach'``), ``t_limit``
     or ``max_steps``. ``problem`` is a :class:`pulloff.solver.Problem` whose ``a`` is the
-    punch radius ``R``.
+    punch radius ``R``. ``machine`` is the dimensionless stiffness ``k_m delta / (sigma_c
+    R^2)`` of a spring between the driver (at ``h0 + t``) and the punch; ``None``: rigid.
 
     The step follows the physics: each step advances ``1/n`` of a measure that adds the time
     in units of ``t_scale`` (the onset time, say) to the distances the contact edge and the
-    zone end travel (in ``R`` and in the initial zone end), predicted from the last step's
-    rates. Doubling ``n`` halves every step of the same solution, so the levels of
-    :func:`simulate_levels` can be compared as with a fixed step.
+    zone end travel (in ``R`` and in the initial zone end) and to the change of the spring's
+    stretch (in ``t_scale`` lifts), predicted from the last step's rates. Doubling ``n``
+    halves every step of the same solution, so the levels of :func:`simulate_levels` can be
+    compared as with a fixed step.
     """
     h0 = problem.h0_scaled
     n_stop = max_steps
@@ -205,7 +257,7 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
     n_pre = max(8, n // 4)
     capacity = n_pre + 2 * (n_stop + 2)
     law = (_Maxwell if problem.arms else _KelvinVoigt)(problem, capacity)
-    ell = law.start(h0)
+    ell = law.start(h0, machine is None)
     if internal:
         xi_a = edge_contact_for_face(ell)
         xi_b = 0.0
@@ -263,7 +315,163 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
             return _finish(rows, dt, t_onset, t_sep, hi - lo, 0, False, notes, ell_onset)
         phase = PHASE_RECEDING
     t_now = 0.0
-    rate = 0.0  # |da/dt| + |db/dt| / b_ref of the last step
+
+    def attempt(h_new, t_new):
+        """Edges after this step for a trial lift ``h_new``; changes no state."""
+        ell_start = law.ell
+        ell_new = law.bonded_trial(h, h_new)
+        ph = phase
+        xa = xi_a
+        released = False
+        onset_frac = ell_on = math.nan
+        g = math.nan
+        new_a, new_b = xa, xi_b
+        if internal and ell_new >= 1.0 and ph in (PHASE_BONDED, PHASE_RECEDING):
+            # The bonded line load needs a zone wider than the face: the bond is gone.
+            if ph == PHASE_BONDED:
+                # The strength limit: the bonded load reaches the rim inside this step.
+                onset_frac = (1.0 - ell_start) / (ell_new - ell_start)
+                ell_on = 1.0
+                if until == "detach":
+                    return _Attempt(h_new, ell_new, ph, xa, xi_b, False, g, 0.0, 0.0,
+                                    onset_frac, ell_on, stop=True)
+            ph = PHASE_ZONE_ONLY
+            released = xa > -1.0
+            xa = -1.0
+        if ph in (PHASE_BONDED, PHASE_RECEDING):
+            xa_try = min(xa, edge_contact_for_face(ell_new)) if internal else xa
+            xb_try = edge_zone_end(xa_try, ell_new)
+            released_try = xa_try < xa
+            g = gap_for(xa_try, xb_try, ell_new, h_new, released_try)
+            if g <= 1.0 and xa_try > -1.0:
+                new_a, new_b, released = xa_try, xb_try, released_try
+            else:
+                if ph == PHASE_BONDED:
+                    # Onset inside this step: the gap crosses 1 between the last two rows.
+                    g_prev = rows["gap"][-1]
+                    onset_frac = (1.0 - g_prev) / (g - g_prev) if g != g_prev else 1.0
+                    ell_on = ell_start + onset_frac * (ell_new - ell_start)
+                    if until == "detach":
+                        return _Attempt(h_new, ell_new, ph, xa, xi_b, False, g, 0.0, 0.0,
+                                        onset_frac, ell_on, stop=True)
+                    ph = PHASE_RECEDING
+
+                def f_a(x_a):
+                    return gap_for(x_a, edge_zone_end(x_a, ell_new), ell_new, h_new,
+                                   True) - 1.0
+
+                released = True
+                if f_a(-1.0) > 0.0:
+                    ph = PHASE_ZONE_ONLY
+                    xa = -1.0
+                else:
+                    new_a = brentq(f_a, -1.0, xa_try, xtol=1e-15, rtol=1e-15)
+                    new_b = edge_zone_end(new_a, ell_new)
+        centre_base, centre_E, centre = math.nan, None, math.nan
+        sep_time = math.nan
+        valid = True
+        if ph == PHASE_ZONE_ONLY:
+            new_a = -1.0
+            # The contact vanished inside this step: the node at the centre is taken as
+            # released at the step's start (u = h then) and loaded since; for an elastic
+            # solid that is its load over k, as it must be.
+            centre_released = released
+            centre_base, centre_E = (law.released_at_start(h) if centre_released
+                                     else (base[lo], None))
+            centre = h_new - centre_base - 1.0  # gap at the centre as the zone vanishes
+
+            def f_b(x_b):
+                if x_b <= -1.0:
+                    return centre
+                u_c = centre_base + law.w_new * kernels.zone_load(-1.0, x_b)
+                # atan2(ell, a) with a = 0 is pi/2 for any ell > 0.
+                return gap_for(-1.0, x_b, 1.0, h_new, centre_released, u_c) - 1.0
+
+            if centre >= 0.0:
+                # Separation inside this step: the centre gap crossed 1.
+                onset_here = not math.isnan(onset_frac)
+                if math.isnan(centre_gap_prev) and (onset_here or t_onset >= t_now):
+                    # Onset, loss of contact and separation in one step: an unstable
+                    # crack, which comes off at the onset.
+                    sep_time = t_now + onset_frac * (t_new - t_now) if onset_here else t_onset
+                else:
+                    frac = 1.0
+                    if not math.isnan(centre_gap_prev) and centre != centre_gap_prev:
+                        frac = -centre_gap_prev / (centre - centre_gap_prev)
+                    sep_time = t_now + min(1.0, max(0.0, frac)) * (t_new - t_now)
+                ph = PHASE_SEPARATED
+                new_b = -1.0
+            else:
+                if internal and f_b(0.0) <= 0.0:
+                    new_b = 0.0  # the zone covers the whole face (the strength limit)
+                else:
+                    hi_b = 0.0 if internal else max(xi_b, -1.0 + 1e-12)
+                    bracketed = f_b(hi_b) >= 0.0
+                    for _ in range(60):
+                        if bracketed:
+                            break
+                        hi_b = -1.0 + 1.5 * (1.0 + hi_b)
+                        bracketed = f_b(hi_b) >= 0.0
+                    # No end found: a trial lift far below the punch's (the machine's search
+                    # tries such); the zone as wide as searched, its force only too large.
+                    new_b = (brentq(f_b, -1.0, hi_b, xtol=1e-15, rtol=1e-15) if bracketed
+                             else hi_b)
+                    valid = bracketed
+            ell_new = 0.0
+        a_now = 1.0 + new_a
+        b_now = 1.0 + new_b if ph != PHASE_SEPARATED else 0.0
+        F_c, F_t = forces(a_now, b_now, ell_new)
+        return _Attempt(h_new, ell_new, ph, new_a, new_b, released, g, F_c, F_t, onset_frac,
+                        ell_on, sep_time, centre_base, centre_E, centre, valid=valid)
+
+    def balanced(t_new):
+        """The attempt whose lift balances the spring: ``kappa (d - h) = F_total``. The root
+        nearest the last lift is taken (the branch the punch is on); when that branch ends,
+        the next root is a jump, which the history shows."""
+        d_new = h0 + t_new
+
+        def residual(h_try):
+            trial = attempt(h_try, t_new)
+            if not trial.valid:
+                return -1e300  # no equilibrium of the zone: as if the force were unbounded
+            return machine * (d_new - h_try) - trial.F_total
+
+        r_here = residual(h)
+        width = max(d_new - h, 1e-12 * max(1.0, abs(h)))
+        lo_h, r_lo = h, r_here
+        if r_here < 0.0:
+            # The punch moves down (the force grew faster than the spring): search below.
+            step_h = 0.05 * width
+            for _ in range(200):
+                hi_h, r_hi = lo_h, r_lo
+                lo_h = lo_h - step_h
+                r_lo = residual(lo_h)
+                if r_lo >= 0.0:
+                    break
+                step_h *= 2.0
+            if r_lo < 0.0:
+                # No lift below balances it either: no equilibrium behind this machine.
+                stuck = attempt(h, t_new)
+                stuck.valid = False
+                return stuck
+            h_root = brentq(residual, lo_h, hi_h, xtol=1e-14 * max(1.0, abs(h)), rtol=1e-15)
+            return attempt(h_root, t_new)
+        # Scan upward from the last lift so the first sign change is found, not a far one.
+        step_h = 0.05 * width
+        hi_h = h
+        for _ in range(200):
+            prev_h = hi_h
+            hi_h = min(d_new, hi_h + step_h)
+            r_hi = residual(hi_h)
+            if r_hi <= 0.0 or hi_h >= d_new:
+                break
+            step_h *= 2.0
+        if r_hi > 0.0:
+            return attempt(d_new, t_new)  # no force at all: the punch follows the driver
+        h_root = brentq(residual, prev_h, hi_h, xtol=1e-14 * max(1.0, abs(h)), rtol=1e-15)
+        return attempt(h_root, t_new)
+
+    rate = 0.0  # |da/dt| + |db/dt| / b_ref + |d(stretch)/dt| / t_scale of the last step
     b_ref = max(1.0, 1.0 + xi_b)
     try:
         while step < n_stop and phase != PHASE_SEPARATED and t_now < t_limit:
@@ -271,137 +479,72 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
             dt_next = 1.0 / (n * (1.0 / t_scale + rate))
             dt = min(dt_next, 2.0 * dt, t_limit - t_now) if step else min(dt_next, t_limit)
             t_new = t_now + dt
-            h_new = h0 + t_new
-            ell_old = law.ell
-            ell_new = law.begin_step(dt, h0 + t_now, h_new)
+            law.prepare(dt)
             law.base(U, E, q_old, lo, hi, base)
-            released = False
-            if internal and ell_new >= 1.0 and phase in (PHASE_BONDED, PHASE_RECEDING):
-                # The bonded line load needs a zone wider than the face: the bond is gone.
-                if phase == PHASE_BONDED:
-                    # The strength limit: the bonded load reaches the rim inside this step.
-                    t_onset = t_now + (1.0 - ell_old) / (ell_new - ell_old) * dt
-                    ell_onset = 1.0
-                    if until == "detach":
-                        break
-                phase = PHASE_ZONE_ONLY
-                released = xi_a > -1.0
-                xi_a = -1.0
-            if phase in (PHASE_BONDED, PHASE_RECEDING):
-                xi_a_try = xi_a
-                if internal:
-                    xi_a_try = min(xi_a, edge_contact_for_face(ell_new))
-                xi_b_try = edge_zone_end(xi_a_try, ell_new)
-                released_try = xi_a_try < xi_a
-                g = gap_for(xi_a_try, xi_b_try, ell_new, h_new, released_try)
-                if g <= 1.0 and xi_a_try > -1.0:
-                    new_a, new_b, released = xi_a_try, xi_b_try, released_try
-                else:
-                    if phase == PHASE_BONDED:
-                        # Onset inside this step: the gap crosses 1 between the last two rows.
-                        g_prev = rows["gap"][-1]
-                        frac = (1.0 - g_prev) / (g - g_prev) if g != g_prev else 1.0
-                        t_onset = t_now + frac * dt
-                        ell_onset = ell_old + frac * (ell_new - ell_old)
-                        if until == "detach":
-                            break
-                        phase = PHASE_RECEDING
-
-                    def f_a(x_a):
-                        return gap_for(x_a, edge_zone_end(x_a, ell_new), ell_new, h_new,
-                                       True) - 1.0
-
-                    if f_a(-1.0) > 0.0:
-                        phase = PHASE_ZONE_ONLY
-                        xi_a = -1.0
-                        released = True
-                    else:
-                        new_a = brentq(f_a, -1.0, xi_a_try, xtol=1e-15, rtol=1e-15)
-                        new_b = edge_zone_end(new_a, ell_new)
-                        released = True
-            if phase == PHASE_ZONE_ONLY:
-                new_a = -1.0
-                # The contact vanished inside this step: the node at the centre is taken as
-                # released at the step's start (u = h then) and loaded since; for an elastic
-                # solid that is its load over k, as it must be.
-                centre_released = released
-                centre_base, centre_E = (law.released_at_start() if centre_released
-                                         else (base[lo], None))
-
-                def u_centre(x_b):
-                    return centre_base + law.w_new * kernels.zone_load(-1.0, x_b)
-
-                centre = h_new - u_centre(-1.0) - 1.0  # gap at the centre as the zone vanishes
-
-                def f_b(x_b):
-                    if x_b <= -1.0:
-                        return centre
-                    # atan2(ell, a) with a = 0 is pi/2 for any ell > 0.
-                    return gap_for(-1.0, x_b, 1.0, h_new, centre_released, u_centre(x_b)) - 1.0
-
-                if centre >= 0.0:
-                    # Separation inside this step: the centre gap crossed 1.
-                    if math.isnan(centre_gap_prev) and t_onset >= t_now:
-                        # Onset, loss of contact and separation in one step: an unstable
-                        # crack, which comes off at the onset.
-                        t_sep = t_onset
-                    else:
-                        frac = 1.0
-                        if not math.isnan(centre_gap_prev) and centre != centre_gap_prev:
-                            frac = -centre_gap_prev / (centre - centre_gap_prev)
-                        t_sep = t_now + min(1.0, max(0.0, frac)) * dt
-                    phase = PHASE_SEPARATED
-                    new_b = -1.0
-                else:
-                    centre_gap_prev = centre
-                    if internal and f_b(0.0) <= 0.0:
-                        new_b = 0.0  # the zone covers the whole face (the strength limit)
-                    else:
-                        hi_b = 0.0 if internal else max(xi_b, -1.0 + 1e-12)
-                        for _ in range(200):
-                            if f_b(hi_b) >= 0.0:
-                                break
-                            hi_b = -1.0 + 1.5 * (1.0 + hi_b)
-                        new_b = brentq(f_b, -1.0, hi_b, xtol=1e-15, rtol=1e-15)
-                ell_new = 0.0
-            # Commit the step with the chosen edge and zone end.
+            att = attempt(h0 + t_new, t_new) if machine is None else balanced(t_new)
+            if (machine is not None and abs((t_new - att.h) - (t_now - h)) > 2.0 * t_scale / n
+                    and dt > 1e-9 * t_scale / n):
+                # The punch jumped further than the step measure allows (the rates came from
+                # the step before): redo the step shorter, so that the jump is resolved.
+                dt_redo = 0.25 * dt
+                rate = max(rate, 1.0 / (n * dt_redo))
+                dt = 2.0 * dt_redo  # the controller halves it back to dt_redo
+                continue
+            if not att.valid:
+                notes.append(f"stopped at t = {t_now:.6g} delta/v: no lift balances the "
+                             "machine with a zone end where gap(b) = delta (once the contact "
+                             "is gone the punch would fall back onto the surface, which the "
+                             "model does not cover)")
+                break
+            if not math.isnan(att.onset_frac):
+                t_onset = t_now + att.onset_frac * dt
+                ell_onset = att.ell_onset
+            if att.stop:
+                break
+            if att.phase == PHASE_SEPARATED:
+                t_sep = att.sep_time
+            if att.phase == PHASE_ZONE_ONLY:
+                centre_gap_prev = att.centre_gap
+            new_a, new_b = att.new_a, att.new_b
+            # Commit the step with the chosen lift, edge and zone end.
             kernels.trial_displacements(base, lo, hi, xi, max(new_b, -1.0), law.w_new, U)
             for j in range(lo, hi):
                 q_old[j] = kernels.zone_load(xi[j], new_b)
             law.commit(E, q_old, lo, hi)
-            if released and new_a < xi[lo]:
+            released_at_edge = False
+            if att.released and new_a < xi[lo]:
                 lo -= 1
                 xi[lo] = new_a
                 q_old[lo] = kernels.zone_load(new_a, new_b)
-                if phase >= PHASE_ZONE_ONLY:
-                    U[lo] = u_centre(new_b)
-                    if centre_E is not None:
-                        E[lo] = centre_E + law.gamma_new * q_old[lo]
+                if att.phase >= PHASE_ZONE_ONLY:
+                    U[lo] = att.centre_base + law.w_new * q_old[lo]
+                    if att.centre_E is not None:
+                        E[lo] = law.with_load(att.centre_E, q_old[lo])
                 else:
-                    U[lo] = h_new
-                    E_now = law.released_now()
-                    if E_now is not None:
-                        E[lo] = E_now
+                    U[lo] = att.h  # bonded until now: it follows the punch
+                    released_at_edge = True
             if new_b > xi[hi - 1]:
                 xi[hi] = new_b
                 U[hi] = 0.0  # enters now, unloaded: its dashpots have not moved either
                 q_old[hi] = 0.0
                 E[hi] = 0.0
                 hi += 1
-            rate = (abs(new_a - xi_a) + abs(max(new_b, -1.0) - xi_b) / b_ref) / dt
-            xi_a, xi_b = new_a, new_b
+            stretch_change = abs((t_new - att.h) - (t_now - h))
+            law.advance_bonded(h, att.h)
+            if released_at_edge and problem.arms:
+                E[lo] = law.released_now()  # the bonded state, advanced to the release
+            rate = (abs(new_a - xi_a) + abs(max(new_b, -1.0) - xi_b) / b_ref
+                    + stretch_change / t_scale) / dt
+            xi_a, xi_b, phase, h = new_a, new_b, att.phase, att.h
             t_now = t_new
             step += 1
-            a_now = 1.0 + xi_a
-            b_now = 1.0 + xi_b if phase != PHASE_SEPARATED else 0.0
-            F_c, F_t = forces(a_now, b_now, ell_new)
             rows["t"].append(t_new)
-            rows["h"].append(h_new)
-            rows["a"].append(a_now)
-            rows["b"].append(b_now)
-            rows["gap"].append(min(g, 1.0) if phase == PHASE_BONDED else 1.0)
-            rows["F_contact"].append(F_c)
-            rows["F_total"].append(F_t)
+            rows["h"].append(att.h)
+            rows["a"].append(1.0 + xi_a)
+            rows["b"].append(1.0 + xi_b if phase != PHASE_SEPARATED else 0.0)
+            rows["gap"].append(min(att.gap, 1.0) if phase == PHASE_BONDED else 1.0)
+            rows["F_contact"].append(att.F_contact)
+            rows["F_total"].append(att.F_total)
             if progress is not None:
                 progress(1)
     except KeyboardInterrupt:
@@ -482,7 +625,7 @@ def outputs(run: PropagationRun, internal: bool) -> np.ndarray:
 
 
 def simulate_levels(problem, rtol: float, t_scale: float, t_limit: float, internal: bool,
-                    until: str, progress: bool = False):
+                    until: str, progress: bool = False, machine: float | None = None):
     """Runs at ``n = 50, 100, 200, ...`` until the Richardson estimate of the finest level's
     relative error (order measured from the last three levels, clipped to [1, 2]) is below
     ``rtol / 2`` or a level would exceed ``MAX_LEVEL_STEPS``. Returns ``(finest run,
@@ -500,7 +643,7 @@ def simulate_levels(problem, rtol: float, t_scale: float, t_limit: float, intern
         try:
             run = run_propagation(problem, n, t_scale, t_limit, internal, until,
                                   max_steps=MAX_LEVEL_STEPS,
-                                  progress=bar.update if bar else None)
+                                  progress=bar.update if bar else None, machine=machine)
         finally:
             if bar is not None:
                 bar.close()

@@ -231,11 +231,21 @@ class Adhesion(_Section):
 
 
 class Loading(_Section):
-    """Punch lift h(t) = h0 + v t."""
+    """The driver moves as h0 + v t; the punch follows it rigidly, or through a spring."""
 
     kind: Literal["constant_velocity"] = Field(description="loading protocol, constant_velocity")
     v: Num = Field(gt=0, description="lift velocity, m/s")
     h0: Num = Field(0.0, ge=0, description="initial lift, m")
+    machine_stiffness: Optional[Num] = Field(
+        None, gt=0, description="stiffness of the spring between driver and punch, N/m; "
+                                "null: a rigid machine")
+
+    @model_validator(mode="after")
+    def _spring_starts_relaxed(self) -> Loading:
+        if self.machine_stiffness is not None and self.h0 != 0:
+            raise _bad_line(f"{{p}}h0 = {_fmt(self.h0)}: with {{p}}machine_stiffness the "
+                            "spring starts relaxed at h = 0; a step lift h0 is not defined")
+        return self
 
 
 class Model(_Section):
@@ -302,11 +312,13 @@ class Scene(BaseModel):
                     raise _bad_line(f"numerics.{key} = {_fmt(value)}: nothing is stepped with "
                                     "model.history = frozen (a closed form); remove it")
         moving_edge = (self.model.until == "separation"
-                       or self.geometry.cohesive_zone == "internal")
+                       or self.geometry.cohesive_zone == "internal"
+                       or self.loading.machine_stiffness is not None)
         if moving_edge and self.model.history == "frozen":
             raise _bad_line("model.history = frozen: the seed's frozen load has no receding "
-                            "contact edge; use history: exact with model.until = separation "
-                            "or geometry.cohesive_zone = internal")
+                            "contact edge or compliant machine; use history: exact with "
+                            "model.until = separation, geometry.cohesive_zone = internal or "
+                            "loading.machine_stiffness")
         if moving_edge and self.numerics.steps is not None:
             raise _bad_line(f"numerics.steps = {_fmt(self.numerics.steps)}: fixed-step runs "
                             "cover the seed's onset only; a receding contact edge "

@@ -808,22 +808,28 @@ def _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_star
     t_scale = t_frozen if math.isfinite(t_frozen) and t_frozen > 0 else 1.0
     if not math.isfinite(t_limit):
         t_limit = propagation.DEFAULT_SPAN * t_scale
+    machine = None
+    if scene.loading.machine_stiffness is not None:
+        # k_m delta / (sigma_c R^2): spring force per unit stretch, in the solver's units.
+        machine = (scene.loading.machine_stiffness * problem.delta
+                   / (problem.sigma_c * problem.a ** 2))
     run, estimate, order = propagation.simulate_levels(problem, rtol, t_scale, t_limit,
-                                                       internal, until, progress)
+                                                       internal, until, progress, machine)
     T = problem.time_scale
     R = problem.a
     force = problem.sigma_c * R * R
-    notes = []
+    notes = list(run.notes)
     if not estimate <= rtol and not run.interrupted:
         notes.append(f"not converged: error estimate {estimate:.2g} above rtol {rtol:g} at "
                      f"the step cap ({propagation.MAX_LEVEL_STEPS} steps per level)")
-    if until == "separation" and math.isnan(run.t_separation) and not run.interrupted:
+    if (until == "separation" and math.isnan(run.t_separation) and not run.interrupted
+            and not run.notes):
         notes.append(f"no separation before t_max = {run.t[-1] * T:.6g} s")
     rows = _decimate(run.t.size, scene.output.history_rows)
     t_hist = run.t[rows]
     history = {
         "t": t_hist * T,
-        "h": problem.lift(t_hist),
+        "h": problem.delta * run.h[rows],  # behind a spring the lift lags the driver
         "a": R * run.a[rows],
         "b": R * run.b[rows],
         "gap": problem.delta * run.gap[rows],
@@ -842,7 +848,8 @@ def _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_star
         history_model=scene.model.history,
         detached=detached,
         t_detach=run.t_onset * T if detached else nan,
-        h_detach=float(problem.lift(run.t_onset)) if detached else nan,
+        h_detach=(problem.delta * float(np.interp(run.t_onset, run.t, run.h))
+                  if detached else nan),
         b_detach=R * b_on if detached else nan,
         zone_ratio_detach=(b_on - a_on) / a_on if detached and a_on > 0 else nan,
         F_contact_detach=F_c_on if detached else nan,
