@@ -209,9 +209,10 @@ def preloaded_mesh(s0: float, n: int):
     return sigma, 2.0 * s0 * np.sin(0.5 * angles) ** 2
 
 
-#: Ages with tabulated weights; older elements use :func:`pulloff.kernels.onset_weight_pair`'s
-#: expansion and the trapezoid in the gap (identical to rounding), so the tables stay small
-#: however long the run.
+#: Ages with tabulated weights, so the tables stay small however long the run. Older elements
+#: use :func:`pulloff.kernels.onset_weight_pair`'s expansion (equal to the tables to rounding)
+#: and, in the gap, the trapezoid on ``v`` (accurate: ``U/q`` has long relaxed). rtol runs
+#: never reach this age.
 _TABLE_AGES = 1 << 16
 #: Rows of one ``march`` call's history buffer: the history in memory never grows with the run
 #: beyond what is recorded.
