@@ -48,13 +48,18 @@ def test_budgeted_run_matches_the_reference_and_estimates_its_error(config):
         assert error / 10 <= result.error_estimate <= 10 * error
 
 
-def test_budget_error_falls_at_fourth_order_where_thinning_dominates():
-    """Wide zone: most of it is entered during the pull, so thinning sets the budget error."""
-    scene = load_scene(CONFIGS / "wide_zone.yaml", overrides=["numerics.steps=40000"])
+def _budget_orders(config, steps, budgets):
+    """Observed orders of the error in the element budget, at a fixed step count."""
+    scene = load_scene(CONFIGS / config, overrides=[f"numerics.steps={steps}"])
     ref = _reference(scene)
     errors = [_error(solver.simulate(scene.with_overrides([f"numerics.max_elements={m}"])), ref)
-              for m in (256, 512, 1024)]
-    orders = [math.log2(errors[i] / errors[i + 1]) for i in range(2)]
+              for m in budgets]
+    return [math.log2(errors[i] / errors[i + 1]) for i in range(len(budgets) - 1)]
+
+
+def test_budget_error_falls_at_fourth_order_where_thinning_dominates():
+    """Wide zone: most of it is entered during the pull, so thinning sets the budget error."""
+    orders = _budget_orders("wide_zone.yaml", 40000, (256, 512, 1024))
     # Measured 4.2 and 4.6 (cubic on a geometric grading).
     assert all(3.5 < order < 6.0 for order in orders), orders
 
@@ -62,11 +67,7 @@ def test_budget_error_falls_at_fourth_order_where_thinning_dominates():
 def test_budget_error_near_viscous_is_second_order():
     """Near-viscous: the whole zone is preloaded; the onset layer at b(0) (width k t, far
     below the capped mesh) limits the preloaded quadrature to second order in the budget."""
-    scene = load_scene(CONFIGS / "hard/near_viscous.yaml", overrides=["numerics.steps=4000"])
-    ref = _reference(scene)
-    errors = [_error(solver.simulate(scene.with_overrides([f"numerics.max_elements={m}"])), ref)
-              for m in (512, 1024, 2048)]
-    orders = [math.log2(errors[i] / errors[i + 1]) for i in range(2)]
+    orders = _budget_orders("hard/near_viscous.yaml", 4000, (512, 1024, 2048))
     assert all(1.8 < order < 2.2 for order in orders), orders
 
 
