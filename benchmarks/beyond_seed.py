@@ -58,10 +58,12 @@ def main() -> None:
         for zone in ("external", "internal"):
             for v in (1e-5, 1e-3, 1e-1):
                 res = solver.simulate(scene(material, v, zone))
+                # (t_sep/t_on is undefined when the bond is gone at t = 0.)
+                ratio = (f"{res.t_separation / res.t_detach:>10.4f}" if res.t_detach > 0
+                         else f"{'-':>10}")
                 lines.append(f"{name:<6} {zone:<9} {v:>7.0e} {res.F_total_detach:>11.5e} "
                              f"{res.F_peak_total:>11.5e} "
-                             f"{res.F_peak_total / res.F_total_detach:>10.4f} "
-                             f"{res.t_separation / res.t_detach:>10.4f} "
+                             f"{res.F_peak_total / res.F_total_detach:>10.4f} {ratio} "
                              f"{res.error_estimate:>9.1e} {res.observed_order:>6.2f}")
     speeds = [10.0 ** e for e in range(-7, 2)]
     lines.append("")
