@@ -580,6 +580,13 @@ def zone_load(xi, xi_b):
 
 
 @njit(cache=True)
+def zone_loads(xi, lo, hi, xi_b, out):
+    """:func:`zone_load` of elements ``lo .. hi - 1`` into ``out``."""
+    for j in range(lo, hi):
+        out[j] = zone_load(xi[j], xi_b)
+
+
+@njit(cache=True)
 def _angle_from_b(ahead, B):
     """``acos(x/b)`` for an element ``ahead = b - x`` inside the zone, without cancellation."""
     return 2.0 * math.asin(min(1.0, math.sqrt(0.5 * ahead / B)))

@@ -30,6 +30,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import kernels
+from .report import progress_bar
 
 PHASE_BONDED, PHASE_RECEDING, PHASE_ZONE_ONLY, PHASE_SEPARATED = 0, 1, 2, 3
 
@@ -134,14 +135,15 @@ class _KelvinVoigt:
         pass  # U is the whole state
 
     def released_at_start(self, h_old):
-        """``(base, E)`` of an element released at the start of the step (u = h then)."""
-        return self.decay * h_old + self.w_old * self.ell, None
+        """``(base, E)`` of an element released at the start of the step (u = h then);
+        a Kelvin-Voigt element has no state besides U."""
+        return self.decay * h_old + self.w_old * self.ell, np.zeros(0)
 
     def released_now(self):
-        return None  # E of an element released at the end of the step
+        return np.zeros(0)  # the state of an element released at the end of the step
 
     def with_load(self, E_pred, q):
-        return None
+        return E_pred
 
 
 class _Maxwell:
@@ -287,8 +289,7 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
     base = np.zeros(capacity)
     scratch = np.zeros(capacity)
     xi[lo:hi] = xi_pre
-    for j in range(lo, hi):
-        q_old[j] = kernels.zone_load(xi[j], xi_b)
+    kernels.zone_loads(xi, lo, hi, xi_b, q_old)
     U[lo:hi] = law.initial_displacement(q_old[lo:hi])
     h = h0
     phase = PHASE_ZONE_ONLY if xi_a <= -1.0 else PHASE_BONDED
@@ -522,9 +523,8 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                 centre_gap_prev = att.centre_gap
             new_a, new_b = att.new_a, att.new_b
             # Commit the step with the chosen lift, edge and zone end.
+            kernels.zone_loads(xi, lo, hi, new_b, q_old)
             kernels.trial_displacements(base, lo, hi, xi, max(new_b, -1.0), law.w_new, U)
-            for j in range(lo, hi):
-                q_old[j] = kernels.zone_load(xi[j], new_b)
             law.commit(E, q_old, lo, hi)
             released_at_edge = False
             if att.released and new_a < xi[lo]:
@@ -533,8 +533,7 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                 q_old[lo] = kernels.zone_load(new_a, new_b)
                 if att.phase >= PHASE_ZONE_ONLY:
                     U[lo] = att.centre_base + law.w_new * q_old[lo]
-                    if att.centre_E is not None:
-                        E[lo] = law.with_load(att.centre_E, q_old[lo])
+                    E[lo] = law.with_load(att.centre_E, q_old[lo])
                 else:
                     U[lo] = att.h  # bonded until now: it follows the punch
                     released_at_edge = True
@@ -546,7 +545,7 @@ def run_propagation(problem, n: int, t_scale: float, t_limit: float = math.inf,
                 hi += 1
             stretch_change = abs((t_new - att.h) - (t_now - h))
             law.advance_bonded(h, att.h)
-            if released_at_edge and problem.arms:
+            if released_at_edge:
                 E[lo] = law.released_now()  # the bonded state, advanced to the release
             rate = (abs(new_a - xi_a) + abs(max(new_b, -1.0) - xi_b) / b_ref
                     + stretch_change / t_scale) / dt
@@ -642,37 +641,26 @@ def outputs(run: PropagationRun, internal: bool) -> np.ndarray:
 def simulate_levels(problem, rtol: float, t_scale: float, t_limit: float, internal: bool,
                     until: str, progress: bool = False, machine: float | None = None):
     """Runs at ``n = 50, 100, 200, ...`` until the Richardson estimate of the finest level's
-    relative error (order measured from the last three levels, clipped to [1, 2]) is below
-    ``rtol / 2`` or a level would exceed ``MAX_LEVEL_STEPS``. Returns ``(finest run,
-    estimate, observed order)``; the estimate assumes an order in [1, 1.5]."""
+    relative error (see :func:`_richardson`) is below ``rtol / 2`` or a level would exceed
+    ``MAX_LEVEL_STEPS``. Returns ``(finest run, estimate, observed order)``."""
     levels = []
     n = 50
     estimate, order = math.nan, math.nan
-    args = (internal,)
     while True:
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(desc=f"n = {n}", unit="step", leave=False)
-        try:
+        with progress_bar(progress, f"n = {n}") as update:
             run = run_propagation(problem, n, t_scale, t_limit, internal, until,
-                                  max_steps=MAX_LEVEL_STEPS,
-                                  progress=bar.update if bar else None, machine=machine)
-        finally:
-            if bar is not None:
-                bar.close()
+                                  max_steps=MAX_LEVEL_STEPS, progress=update, machine=machine)
         levels.append(run)
         if run.interrupted:
             return run, math.nan, math.nan
         if len(levels) >= 3:
-            estimate, order = _richardson([outputs(r, *args) for r in levels[-3:]])
+            estimate, order = _richardson([outputs(r, internal) for r in levels[-3:]])
             if estimate <= 0.5 * rtol:
                 return run, estimate, order
         # The next level takes about twice the steps of this one.
         if 2 * run.n_steps > MAX_LEVEL_STEPS or run.n_steps >= MAX_LEVEL_STEPS:
             if len(levels) < 3 and len(levels) >= 2:
-                values = [outputs(r, *args) for r in levels[-2:]]
+                values = [outputs(r, internal) for r in levels[-2:]]
                 estimate = _relative_spread(values[0], values[1]) / 3.0
             return run, estimate, order
         n *= 2
@@ -686,7 +674,10 @@ def _relative_spread(a, b):
 
 
 def _richardson(values):
-    """Estimate and order from three levels (step ratio 2), the worst of the outputs."""
+    """``(estimate, measured order)`` of the finest of three levels (step ratio 2), for the
+    output that changed most: Richardson with the measured order clipped to [1, 1.5]; below
+    an order of 0.5 the levels are not converging and the estimate is the larger of their
+    last two differences."""
     v0, v1, v2 = values
     if not np.array_equal(np.isnan(v1), np.isnan(v2)):
         return math.inf, math.nan  # separation found on one level only: not resolved

@@ -2,9 +2,26 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
+
+
+@contextlib.contextmanager
+def progress_bar(enabled: bool, desc: str, total: int | None = None, unit: str = "step"):
+    """A tqdm bar on the terminal while the block runs: yields its ``update`` (or ``None``
+    when ``enabled`` is false), and closes it however the block ends."""
+    if not enabled:
+        yield None
+        return
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit=unit, leave=False)
+    try:
+        yield bar.update
+    finally:
+        bar.close()
 
 
 def _fmt(value, unit=""):

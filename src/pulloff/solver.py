@@ -23,6 +23,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import analytic, kernels
+from .report import progress_bar
 
 #: Steps per reference time at ``rtol = 1``; the measured error constant of the stepper on the
 #: shipped scenes is ~1e-2 (relative error ~ 1e-2 / N^2), so this starts one doubling short.
@@ -628,28 +629,18 @@ def _fixed_run(problem, t_frozen, t_limit, scene, snapshot_times, progress, stre
     if t_ref == 0.0:
         return run_foundation(problem, 1.0, 0), 0.0
 
-    def steps_to_cover(m):
-        return m if t_ref >= t_limit else m + max(2, m // 16)
-
-    preview = max(1, math.ceil(steps_to_cover(n) / scene.output.history_rows))
+    preview = max(1, math.ceil(_steps_to_cover(n, t_ref, t_limit) / scene.output.history_rows))
     runs = []
     # The streamed run first: a Ctrl-C during the check leaves its whole history in the file.
     for m, budget, sink in ((n, max_elements, stream),
                             (n // 2, max(64, int(max_elements / math.sqrt(2.0))), None)):
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=steps_to_cover(m), desc=f"{m} steps", unit="step", leave=False)
-        try:
-            runs.append(run_foundation(problem, t_ref / m, steps_to_cover(m),
+        total = _steps_to_cover(m, t_ref, t_limit)
+        with progress_bar(progress, f"{m} steps", total) as update:
+            runs.append(run_foundation(problem, t_ref / m, total,
                                        snapshot_times if sink is stream else (),
-                                       progress=bar.update if bar else None,
-                                       record_every=preview, max_elements=budget,
-                                       stream=sink, stream_every=_stream_every(scene)))
-        finally:
-            if bar is not None:
-                bar.close()
+                                       progress=update, record_every=preview,
+                                       max_elements=budget, stream=sink,
+                                       stream_every=_stream_every(scene)))
         if runs[-1].interrupted:
             return dataclasses.replace(runs[0], interrupted=True), math.nan
     full, half = runs
@@ -661,22 +652,24 @@ def _fixed_run(problem, t_frozen, t_limit, scene, snapshot_times, progress, stre
     return full, float(np.max(np.abs(values[0] - values[1]) / np.abs(values[0])) / 3.0)
 
 
+def _steps_to_cover(n: int, t_ref: float, t_limit: float) -> int:
+    """Steps for ``n`` steps per ``t_ref``: the frozen time bounds detachment from above, but
+    rounding can put the crossing a hair beyond it, and a few spare steps are cheap. A user's
+    ``t_max`` is a hard end."""
+    return n if t_ref >= t_limit else n + max(2, n // 16)
+
+
 def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress, every=None,
                max_elements=None):
     t_ref = min(t_frozen, t_limit)
     if t_ref == 0.0:
         return run_foundation(problem, 1.0, 0), 0.0
 
-    def steps_to_cover(n):
-        # The frozen time bounds detachment from above, but rounding can put the crossing a
-        # hair beyond it; a few spare steps are cheap. A user's t_max is a hard end.
-        return n if t_ref >= t_limit else n + max(2, n // 16)
-
     def level(n, snapshots=(), progress=None):
         # In memory: every user-chosen step, or a power of two that keeps ~2000-4000 rows and
         # lands the rows of consecutive levels on common times (for the gap comparison).
         record = every if every is not None else max(1, n // 2048)
-        return run_foundation(problem, t_ref / n, steps_to_cover(n), snapshots,
+        return run_foundation(problem, t_ref / n, _steps_to_cover(n, t_ref, t_limit), snapshots,
                               progress=progress, record_every=record,
                               max_elements=max_elements)
 
@@ -692,16 +685,8 @@ def _exact_run(problem, t_frozen, t_limit, rtol, snapshot_times, progress, every
         return levels[-1], math.nan
     while True:
         n *= 2
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=steps_to_cover(n), desc=f"{n} steps", unit="step", leave=False)
-        try:
-            levels.append(level(n, snapshot_times, bar.update if bar else None))
-        finally:
-            if bar is not None:
-                bar.close()
+        with progress_bar(progress, f"{n} steps", _steps_to_cover(n, t_ref, t_limit)) as update:
+            levels.append(level(n, snapshot_times, update))
         if levels[-1].interrupted:
             return levels[-1], math.nan
         if len(levels) < 3 and 2 * n <= _MAX_STEPS:
@@ -839,11 +824,11 @@ def _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_star
     }
     detached = math.isfinite(run.t_onset)
     nan = math.nan
-    args = (internal,)
-    a_on, b_on, F_c_on, F_t_on = propagation.onset_state(run, *args)
+    a_on, b_on, F_c_on, F_t_on = propagation.onset_state(run, internal)
     F_c_on, F_t_on = force * F_c_on, force * F_t_on
-    (t_pc, F_pc), (t_pt, F_pt) = propagation.peaks(run, *args)
-    t_pc, F_pc, t_pt, F_pt = t_pc * T, F_pc * force, t_pt * T, F_pt * force
+    (t_pc, F_pc), (t_pt, F_pt) = propagation.peaks(run, internal)
+    t_pc, F_pc, t_pt, F_pt = (float(x) for x in (t_pc * T, F_pc * force, t_pt * T,
+                                                 F_pt * force))
     result = Result(
         problem=problem,
         history_model=scene.model.history,
@@ -869,7 +854,7 @@ def _simulate_moving_edge(scene, problem, t_frozen, t_limit, progress, wall_star
         analytic=analytic_predictions(problem, internal),
         until=until,
         cohesive_zone=scene.geometry.cohesive_zone,
-        t_separation=run.t_separation * T,
+        t_separation=float(run.t_separation * T),
         F_peak_contact=F_pc,
         F_peak_total=F_pt,
         t_peak_contact=t_pc,
