@@ -23,7 +23,7 @@ def _cmd_run(args) -> int:
     with h5io.atomic_file(out) as f:
         # A fixed-step run streams its history into the file while it runs.
         stream = h5io.HistoryStream(f) if scene.numerics.steps is not None else None
-        result = solver.simulate(scene, progress=not args.quiet and sys.stderr.isatty(),
+        result = solver.simulate(scene, progress=_show_progress(args),
                                  stream=stream)
         record = h5io.result_to_record(result, scene_mod.scene_to_yaml(scene))
         h5io.fill(f, record, history_streamed=result.history_streamed)
@@ -54,10 +54,15 @@ def _cmd_sweep(args) -> int:
     start = time.perf_counter()
     result = sweep_mod.sweep(scene, axes, out=args.output, workers=args.workers,
                              scheduler=args.scheduler, histories=args.histories,
-                             progress=not args.quiet and sys.stderr.isatty())
+                             progress=_show_progress(args))
     print(report.format_sweep(result))
     print(f"  {time.perf_counter() - start:.1f} s; wrote {args.output}")
     return 0
+
+
+def _show_progress(args) -> bool:
+    """A progress bar only on a terminal, and not with --quiet."""
+    return not args.quiet and sys.stderr.isatty()
 
 
 def _check_writable(path: Path, key: str) -> None:
@@ -74,7 +79,7 @@ def _cmd_validate(args) -> int:
 
     report_path = validate.validate(args.output, rtol=args.rtol, small=args.small,
                                     workers=args.workers,
-                                    progress=not args.quiet and sys.stderr.isatty())
+                                    progress=_show_progress(args))
     print(f"wrote {report_path} and its figures")
     return 0
 
