@@ -1,0 +1,1 @@
+"""Independent references: slow, accurate solvers of the same model by other methods."""
