@@ -24,8 +24,8 @@ import numpy as np
 import scipy.sparse
 from scipy.integrate import solve_ivp
 
-from pulloff import kernels
-from pulloff.solver import (Problem, _crossing_time, frozen_detach_time, preloaded_mesh,
+from pulloff.kernels import onset as kernels
+from pulloff.solvers.onset import (Problem, _crossing_time, frozen_detach_time, preloaded_mesh,
                             step_weights)
 
 

@@ -22,8 +22,9 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from pulloff import analytic, solver  # noqa: E402
-from pulloff.scene import load_scene, parse_scene  # noqa: E402
+from pulloff import solvers  # noqa: E402
+from pulloff.model import analytic  # noqa: E402
+from pulloff.io.scene_file import load_scene, parse_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 G_INF, G_1, TAU_1, SIGMA_C, DELTA, R = 1e6, 9e6, 1e-3, 1e7, 3e-6, 1e-5
@@ -57,7 +58,7 @@ def main() -> None:
     for name, material in (("KV", KV), ("SLS", SLS)):
         for zone in ("external", "internal"):
             for v in (1e-5, 1e-3, 1e-1):
-                res = solver.simulate(scene(material, v, zone))
+                res = solvers.simulate(scene(material, v, zone))
                 # (t_sep/t_on is undefined when the bond is gone at t = 0.)
                 ratio = (f"{res.t_separation / res.t_detach:>10.4f}" if res.t_detach > 0
                          else f"{'-':>10}")
@@ -74,7 +75,7 @@ def main() -> None:
     for v in speeds:
         row = f"{v:>7.0e}"
         for zone in ("external", "internal"):
-            res = solver.simulate(scene(SLS, v, zone))
+            res = solvers.simulate(scene(SLS, v, zone))
             curves[zone][0].append(res.F_total_detach)
             curves[zone][1].append(res.F_peak_total)
             row += f" {res.F_total_detach:>11.5e} {res.F_peak_total:>11.5e}"
@@ -90,7 +91,7 @@ def main() -> None:
     out.mkdir(exist_ok=True)
     (out / "beyond_seed.txt").write_text(text + "\n")
 
-    kv = solver.simulate(load_scene(ROOT / "configs" / "separation_kv.yaml"))
+    kv = solvers.simulate(load_scene(ROOT / "configs" / "separation_kv.yaml"))
     h = kv.history
     fig, (ax_h, ax_v) = plt.subplots(1, 2, figsize=(11.0, 4.2), constrained_layout=True)
     t_ms = h["t"] * 1e3

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pulloff.scene import scene_from_groups
+from pulloff.io.scene_file import scene_from_groups
 
 
 # --------------------------------------------------------------------------------------------

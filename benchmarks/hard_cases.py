@@ -3,7 +3,7 @@
     python benchmarks/hard_cases.py
 
 For every scene under configs/hard/ and rtol in {1e-3, 1e-6, 1e-8}: the true relative error of
-F_contact and t_detach against the independent quadrature reference (``pulloff.reference``
+F_contact and t_detach against the independent quadrature reference (``pulloff.references.onset``
 at 1e-12), the solver's own estimate, the number of steps and elements, and the median warm
 time of 5 runs. Single thread. Writes results/hard_cases.txt with the same table.
 """
@@ -15,9 +15,9 @@ import statistics
 import time
 from pathlib import Path
 
-from pulloff.reference import reference_detachment
-from pulloff.scene import load_scene
-from pulloff.solver import simulate
+from pulloff.references.onset import reference_detachment
+from pulloff.io.scene_file import load_scene
+from pulloff.solvers import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 RTOLS = (1e-3, 1e-6, 1e-8)

@@ -25,10 +25,11 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from common import loglog_slope, machine_summary, scene_for_groups, time_call  # noqa: E402
-from pulloff import kernels  # noqa: E402
-from pulloff.solver import (Problem, analytic_predictions, frozen_detach_time,  # noqa: E402
-                            preloaded_mesh, run_foundation, simulate,
-                            step_weights)
+from pulloff.kernels import onset as kernels  # noqa: E402
+from pulloff.model.analytic import predictions  # noqa: E402
+from pulloff.solvers import simulate  # noqa: E402
+from pulloff.solvers.onset import (Problem, frozen_detach_time, preloaded_mesh,  # noqa: E402
+                                   run_foundation, step_weights)
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SIZES = [100, 1_000, 10_000, 100_000]
@@ -273,11 +274,12 @@ def report_simulate(alpha, chi):
         "rtol/2, so each\n  doubling of N (4x in time) covers a factor ~4 in rtol; at loose "
         "rtol the fixed costs of a run\n  flatten the curve. Fixed costs inside every "
         "simulate call:")
-    problem = Problem.from_scene(scene_for_groups(alpha, chi))
+    scene = scene_for_groups(alpha, chi)
+    problem = Problem.from_scene(scene)
     t_ref = frozen_detach_time(problem)
     for label, call in (
-            ("closed forms beside the result (solver.analytic_predictions)",
-             lambda: analytic_predictions(problem)),
+            ("closed forms beside the result (model.analytic.predictions)",
+             lambda: predictions(scene)),
             ("frozen detachment time (solver.frozen_detach_time)",
              lambda: frozen_detach_time(problem)),
             ("weight tables of one 200-step level (onset + age-interval)",
@@ -337,7 +339,7 @@ def main() -> None:
     out(machine_summary())
     problem = Problem.from_scene(scene_for_groups(*SCENE))
     out(f"scene alpha = {SCENE[0]:g}, chi = {SCENE[1]:g}: k = {problem.k:.4g}, c = "
-        f"{problem.c:.4g} (dimensionless, units of solver.py)\n")
+        f"{problem.c:.4g} (dimensionless, units of solvers/problem.py)\n")
     report_kernels(problem)
     report_march(problem)
     report_simulate(*SCENE)

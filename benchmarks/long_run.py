@@ -9,7 +9,7 @@ The long run is ``pulloff run configs/seed_flat_punch.yaml`` with ``numerics.ste
 in a child process that reports its own peak resident memory; the same command at 1000 steps
 gives the baseline (interpreter, numpy, numba, scipy, h5py, matplotlib). The study runs
 scenes at 40000 steps through budgets of 128 to 2048 elements against the independent
-quadrature reference (``pulloff.reference``), with the observed order in the budget.
+quadrature reference (``pulloff.references.onset``), with the observed order in the budget.
 Single thread. Writes results/long_run.txt.
 """
 
@@ -62,10 +62,10 @@ def run_child(steps: int, out: Path) -> dict:
 def long_run(steps: int, lines: list) -> None:
     import h5py
 
-    from pulloff import h5io
-    from pulloff.reference import reference_detachment
-    from pulloff.scene import load_scene
-    from pulloff.solver import Problem
+    from pulloff.io import h5 as h5io
+    from pulloff.references.onset import reference_detachment
+    from pulloff.io.scene_file import load_scene
+    from pulloff.solvers.onset import Problem
 
     with tempfile.TemporaryDirectory() as tmp:
         base = run_child(1000, Path(tmp) / "base.h5")
@@ -98,9 +98,10 @@ def long_run(steps: int, lines: list) -> None:
 def study(lines: list) -> None:
     import time
 
-    from pulloff.reference import reference_detachment
-    from pulloff.scene import load_scene
-    from pulloff.solver import Problem, simulate
+    from pulloff.references.onset import reference_detachment
+    from pulloff.io.scene_file import load_scene
+    from pulloff.solvers import simulate
+    from pulloff.solvers.problem import Problem
 
     steps = 40000
     lines.append(f"== element budget against the reference, {steps} steps "
@@ -116,7 +117,7 @@ def study(lines: list) -> None:
         prev = None
         for budget in BUDGETS:
             start = time.perf_counter()
-            res = simulate(scene.with_overrides([f"numerics.max_elements={budget}"]))
+            res = simulate(override(scene, [f"numerics.max_elements={budget}"]))
             wall = time.perf_counter() - start
             err = max(abs(res.t_detach / ref["t_detach"] - 1),
                       abs(res.F_total_detach / ref["F_total"] - 1))

@@ -4,7 +4,7 @@
 
 For each config under configs/: the first call's time (numba compile or cache load included,
 reported on its own), the median and spread of repeated warm runs of ``simulate``, the
-achieved relative error against the independent quadrature reference (``pulloff.reference``)
+achieved relative error against the independent quadrature reference (``pulloff.references.onset``)
 and the solver's own error estimate. Single-threaded; numba's threading is not used.
 """
 
@@ -15,9 +15,9 @@ import statistics
 import time
 from pathlib import Path
 
-from pulloff.reference import reference_detachment
-from pulloff.scene import load_scene
-from pulloff.solver import simulate
+from pulloff.references.onset import reference_detachment
+from pulloff.io.scene_file import load_scene
+from pulloff.solvers import simulate
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 

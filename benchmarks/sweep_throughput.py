@@ -16,8 +16,8 @@ import math
 import time
 from pathlib import Path
 
-from pulloff.scene import load_scene
-from pulloff.sweeps import Axis, sweep
+from pulloff.io.scene_file import load_scene
+from pulloff.studies.sweeps import Axis, sweep
 
 SEED = Path(__file__).resolve().parents[1] / "configs" / "seed_flat_punch.yaml"
 

@@ -4,7 +4,7 @@
 
 For four scenes (alpha 0.1, 1 and 10 with a thin zone, chi = 1e-4, and alpha = 10 with
 (b - a)/a ~ 1, chi = 1) it measures the relative error of F_contact at detachment against the
-independent quadrature reference (``pulloff.reference``, rtol 1e-12, good to ~1e-12) and the
+independent quadrature reference (``pulloff.references.onset``, rtol 1e-12, good to ~1e-12) and the
 warm wall time [s] of:
 
 a. ``simulate`` at rtol 1e-2 .. 1e-9 (the product, accuracy control included);
@@ -37,9 +37,10 @@ import numpy as np  # noqa: E402
 
 from baselines import march_numpy, mol_detachment  # noqa: E402
 from common import loglog_slope, machine_summary, scene_for_groups, time_call  # noqa: E402
-from pulloff import analytic  # noqa: E402
-from pulloff.reference import reference_detachment  # noqa: E402
-from pulloff.solver import Problem, frozen_detach_time, run_foundation, simulate  # noqa: E402
+from pulloff.model import analytic  # noqa: E402
+from pulloff.references.onset import reference_detachment  # noqa: E402
+from pulloff.solvers import simulate  # noqa: E402
+from pulloff.solvers.onset import Problem, frozen_detach_time, run_foundation  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
@@ -296,7 +297,7 @@ for var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL
 sys.path.insert(0, {here!r})
 t0 = time.perf_counter()
 from common import scene_for_groups
-from pulloff.solver import simulate
+from pulloff.solvers import simulate
 t1 = time.perf_counter()
 scene = scene_for_groups(1.0, 1e-4)
 t2 = time.perf_counter()

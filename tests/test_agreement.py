@@ -1,4 +1,4 @@
-"""The time-stepped simulator against the independent quadrature reference (pulloff.reference).
+"""The time-stepped simulator against the independent quadrature reference (pulloff.references.onset).
 
 The reference integrates the same model by nested adaptive quadrature of the explicit element
 solutions (a different method, sharing no code with the stepper) to ~1e-12.
@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from pulloff.reference import reference_detachment
-from pulloff.scene import load_scene
-from pulloff.solver import simulate
+from pulloff.references.onset import reference_detachment
+from pulloff.io.scene_file import load_scene
+from pulloff.solvers import simulate
 from test_solver import make_scene, scene_for_groups
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"

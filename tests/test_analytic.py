@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from pulloff import analytic as A
+from pulloff.model import analytic as A
 
 import mpmath as mp
 from hypothesis import given, settings

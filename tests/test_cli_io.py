@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 import yaml
 
-from pulloff import h5io
+from pulloff.io import h5 as h5io
 from pulloff.cli import main
-from pulloff.scene import SceneLoader, load_scene, parse_scene, scene_to_yaml
-from pulloff.solver import simulate
+from pulloff.io.scene_file import SceneLoader, load_scene, parse_scene, scene_to_yaml
+from pulloff.solvers import simulate
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 SEED = CONFIGS / "seed_flat_punch.yaml"
@@ -136,9 +136,9 @@ def test_cli_missing_file(tmp_path, capsys):
 
 
 def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypatch):
-    from pulloff import solver
+    from pulloff.kernels import onset as onset_kernels
 
-    real = solver.kernels.march
+    real = onset_kernels.march
 
     def march_then_interrupt(*args):
         step = args[12]
@@ -146,7 +146,7 @@ def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypa
             raise KeyboardInterrupt
         return real(*args)
 
-    monkeypatch.setattr(solver.kernels, "march", march_then_interrupt)
+    monkeypatch.setattr(onset_kernels, "march", march_then_interrupt)
     out = tmp_path / "cut.h5"
     assert main(["run", str(SEED), "-o", str(out), "-q", "--set", "numerics.rtol=1e-9"]) == 130
     assert "complete = False" in capsys.readouterr().err

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pulloff.reference import reference_detachment
-from pulloff.scene import load_scene
-from pulloff.solver import simulate
+from pulloff.references.onset import reference_detachment
+from pulloff.io.scene_file import load_scene
+from pulloff.solvers import simulate
 
 HARD = Path(__file__).resolve().parents[1] / "configs" / "hard"
 DETACHING = sorted(p.stem for p in HARD.glob("*.yaml")

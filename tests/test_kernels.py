@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.integrate import quad, solve_ivp
 
-from pulloff import kernels as K
+from pulloff.kernels import onset as K
 
 RULE = (K.TS_NODES, K.TS_COMPLEMENTS, K.TS_WEIGHTS)
 FINE = (K.TS_FINE_NODES, K.TS_FINE_COMPLEMENTS, K.TS_FINE_WEIGHTS)

@@ -11,16 +11,20 @@ import h5py
 import numpy as np
 import pytest
 
-from pulloff import h5io, solver
+from pulloff.io.scene_file import override
+from pulloff import solvers
+from pulloff.io import h5 as h5io
+from pulloff.kernels import onset as onset_kernels
+from pulloff.solvers.problem import Problem
 from pulloff.cli import main
-from pulloff.reference import reference_detachment
-from pulloff.scene import SceneError, load_scene
+from pulloff.references.onset import reference_detachment
+from pulloff.io.scene_file import SceneError, load_scene
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
 
 def _reference(scene):
-    p = solver.Problem.from_scene(scene)
+    p = Problem.from_scene(scene)
     return reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=1e-12)
 
 
@@ -34,7 +38,7 @@ def _error(result, ref):
 def test_budgeted_run_matches_the_reference_and_estimates_its_error(config):
     scene = load_scene(CONFIGS / f"{config}.yaml",
                        overrides=["numerics.steps=20000", "numerics.max_elements=512"])
-    result = solver.simulate(scene)
+    result = solvers.simulate(scene)
     ref = _reference(scene)
     error = _error(result, ref)
     # The element state is bounded by the budget, and thinning actually happened.
@@ -52,7 +56,7 @@ def _budget_orders(config, steps, budgets):
     """Observed orders of the error in the element budget, at a fixed step count."""
     scene = load_scene(CONFIGS / config, overrides=[f"numerics.steps={steps}"])
     ref = _reference(scene)
-    errors = [_error(solver.simulate(scene.with_overrides([f"numerics.max_elements={m}"])), ref)
+    errors = [_error(solvers.simulate(override(scene, [f"numerics.max_elements={m}"])), ref)
               for m in budgets]
     return [math.log2(errors[i] / errors[i + 1]) for i in range(len(budgets) - 1)]
 
@@ -75,7 +79,7 @@ def test_a_long_run_keeps_its_state_bounded():
     """2e5 steps through 256 elements: the arrays are thinned hundreds of times."""
     scene = load_scene(CONFIGS / "wide_zone.yaml",
                        overrides=["numerics.steps=200000", "numerics.max_elements=256"])
-    result = solver.simulate(scene)
+    result = solvers.simulate(scene)
     assert result.n_steps > 150_000
     assert result.n_elements <= 256
     # The in-memory history is a preview of output.history_rows rows at most.
@@ -108,7 +112,7 @@ def test_fixed_run_streams_every_step_to_the_file(tmp_path):
     assert hist["F_contact"][-1] == pytest.approx(record["summary"]["F_contact_detach"], rel=1e-14)
     # The same run in memory (no stream) records the same steps: its preview is a subset.
     scene = load_scene(CONFIGS / "seed_flat_punch.yaml", overrides=sets)
-    preview = solver.simulate(scene).history
+    preview = solvers.simulate(scene).history
     idx = np.searchsorted(hist["t"], preview["t"])
     assert np.allclose(hist["gap"][idx], preview["gap"], rtol=0, atol=1e-22)
     # Reading a capped number of rows keeps the first and the last.
@@ -120,7 +124,7 @@ def test_fixed_run_streams_every_step_to_the_file(tmp_path):
 
 def test_ctrl_c_during_a_streamed_run_leaves_a_valid_incomplete_file(tmp_path, monkeypatch,
                                                                       capsys):
-    real = solver.kernels.march
+    real = onset_kernels.march
     calls = []
 
     def march_then_interrupt(*args):
@@ -129,7 +133,7 @@ def test_ctrl_c_during_a_streamed_run_leaves_a_valid_incomplete_file(tmp_path, m
             raise KeyboardInterrupt
         return real(*args)
 
-    monkeypatch.setattr(solver.kernels, "march", march_then_interrupt)
+    monkeypatch.setattr(onset_kernels, "march", march_then_interrupt)
     out = tmp_path / "cut.h5"
     code = main(["run", str(CONFIGS / "wide_zone.yaml"), "-o", str(out), "-q",
                  "--set", "numerics.steps=20000", "--set", "numerics.max_elements=128",

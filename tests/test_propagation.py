@@ -12,8 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pulloff import analytic, propagation, solver
-from pulloff.scene import SceneError, load_scene, parse_scene
+from pulloff.io.scene_file import override
+from pulloff import solvers
+from pulloff.model import analytic
+from pulloff.solvers import edge as propagation
+from pulloff.solvers.frozen import frozen_detach_time
+from pulloff.solvers.problem import Problem
+from pulloff.io.scene_file import SceneError, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -32,7 +37,7 @@ def internal_scene(chi, eta=0.0, until="detach", rtol=1e-3):
 
 
 def test_elastic_crack_separates_at_the_onset_with_the_closed_form_force():
-    res = solver.simulate(load_scene(CONFIGS / "separation_elastic.yaml"))
+    res = solvers.simulate(load_scene(CONFIGS / "separation_elastic.yaml"))
     p = res.problem
     exact = analytic.elastic_mdr_dugdale(p.G, p.sigma_c, p.delta, p.a)
     # Unstable under a rigid lift: off at once, the largest force is the onset force.
@@ -47,8 +52,8 @@ def test_elastic_crack_separates_at_the_onset_with_the_closed_form_force():
 @pytest.fixture(scope="module")
 def kv_levels():
     scene = load_scene(CONFIGS / "separation_kv.yaml")
-    p = solver.Problem.from_scene(scene)
-    t_scale = solver.frozen_detach_time(p)
+    p = Problem.from_scene(scene)
+    t_scale = frozen_detach_time(p)
     runs = {n: propagation.run_propagation(p, n, t_scale) for n in (50, 100, 200, 400)}
     return p, runs
 
@@ -85,8 +90,8 @@ def test_onset_agrees_with_the_seed_model_solver():
     """Before the edge moves the propagation solver solves the seed model: its onset must
     agree with the seed solver's (rtol 1e-7) within its own estimate."""
     scene = load_scene(CONFIGS / "separation_kv.yaml")
-    seed = solver.simulate(scene.with_overrides(["model.until=detach", "numerics.rtol=1e-7"]))
-    res = solver.simulate(scene)
+    seed = solvers.simulate(override(scene, ["model.until=detach", "numerics.rtol=1e-7"]))
+    res = solvers.simulate(scene)
     for name in ("t_detach", "F_contact_detach", "F_total_detach"):
         err = abs(getattr(res, name) / getattr(seed, name) - 1.0)
         assert err <= 10 * res.error_estimate
@@ -96,7 +101,7 @@ def test_onset_agrees_with_the_seed_model_solver():
 @pytest.mark.parametrize("chi", [1e-3, 1e-2, 0.1, 0.5, 0.6, 1.0, 10.0])
 def test_finite_punch_matches_the_elastic_closed_form_across_chi(chi):
     """chi_R >= pi/2 - 1 = 0.571 is the strength-limited regime: F = pi R^2 sigma_c."""
-    res = solver.simulate(internal_scene(chi))
+    res = solvers.simulate(internal_scene(chi))
     p = res.problem
     exact = analytic.elastic_internal_onset(p.G, p.sigma_c, p.delta, p.a)
     # Measured: 1.9e-7 .. 1.6e-6 relative, and exact in the strength-limited regime.
@@ -107,7 +112,7 @@ def test_finite_punch_matches_the_elastic_closed_form_across_chi(chi):
 
 
 def test_finite_punch_force_never_exceeds_the_strength_limit():
-    res = solver.simulate(load_scene(CONFIGS / "finite_punch_internal.yaml"))
+    res = solvers.simulate(load_scene(CONFIGS / "finite_punch_internal.yaml"))
     p = res.problem
     limit = math.pi * p.a**2 * p.sigma_c
     assert np.max(res.history["F_total"]) <= limit * (1 + 1e-12)
@@ -158,7 +163,7 @@ def test_moving_edge_settings_are_checked_before_any_work(overrides, key):
 def machine_run(k_m, config="separation_kv.yaml", extra=()):
     """One run per setting for the whole module (several tests look at the same runs)."""
     overrides = [f"loading.machine_stiffness={k_m}"] if k_m else []
-    return solver.simulate(load_scene(CONFIGS / config, overrides=overrides + list(extra)))
+    return solvers.simulate(load_scene(CONFIGS / config, overrides=overrides + list(extra)))
 
 
 def test_stiff_machine_tends_to_the_rigid_one_as_one_over_its_stiffness():

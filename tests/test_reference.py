@@ -1,4 +1,4 @@
-"""Tests of the quadrature reference (pulloff.reference) against closed forms, limits, an ODE
+"""Tests of the quadrature reference (pulloff.references.onset) against closed forms, limits, an ODE
 solver and itself."""
 
 import math
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
-from pulloff.reference import reference_detachment, reference_displacement, reference_gap
+from pulloff.references.onset import reference_detachment, reference_displacement, reference_gap
 
 
 def scene(chi, alpha, a=1e-3, G=1e6, delta=1e-6, v=1e-3):

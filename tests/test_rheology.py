@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pulloff import analytic, solver
-from pulloff.propagation import _Maxwell
-from pulloff.scene import SceneError, load_scene, parse_scene
+from pulloff import solvers
+from pulloff.model import analytic
+from pulloff.solvers.edge import _Maxwell
+from pulloff.io.scene_file import SceneError, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 G_INF, G_1, TAU_1, SIGMA_C, DELTA, R = 1e6, 9e6, 1e-3, 1e7, 3e-6, 1e-5
@@ -42,8 +43,8 @@ def elastic(G, zone):
 @pytest.mark.parametrize("zone", ["internal", "external"])
 def test_standard_linear_solid_limits_are_the_elastic_closed_forms(zone):
     """tau_1 = 1 ms: a pull lasting ~200 s sees G_inf, one lasting ~1 us sees G_inf + G_1."""
-    slow = solver.simulate(scene(1e-7, zone))
-    fast = solver.simulate(scene(10.0, zone))
+    slow = solvers.simulate(scene(1e-7, zone))
+    fast = solvers.simulate(scene(10.0, zone))
     # Measured: slow +3.8e-5 (internal) and -1.3e-4 (external) off the relaxed elastic
     # force (relaxation at t/tau ~ 2e5 is complete; this is the order-1.5 step at rtol 1e-3);
     # fast -9.8e-4 (external: the arm relaxes by t/tau ~ 1e-3 before the onset); internal:
@@ -63,7 +64,7 @@ def test_finite_punch_peak_rises_with_speed_between_the_two_elastic_limits():
     low = elastic(G_INF, "internal")["F_total"]
     high = min(elastic(G_INF + G_1, "internal")["F_total"], math.pi * R**2 * SIGMA_C)
     speeds = [1e-7, 1e-5, 1e-4, 1e-3, 1e-2, 1.0]
-    peaks = [solver.simulate(scene(v)).F_peak_total for v in speeds]
+    peaks = [solvers.simulate(scene(v)).F_peak_total for v in speeds]
     assert all(low * (1 - 1e-4) <= F <= high * (1 + 1e-12) for F in peaks), peaks
     assert all(b >= a * (1 - 1e-4) for a, b in zip(peaks, peaks[1:])), peaks
     # Measured: 1.6678e-3 at 1e-7 m/s up to 3.1416e-3 (the strength limit) from 1e-2 m/s.
@@ -74,15 +75,15 @@ def test_finite_punch_peak_rises_with_speed_between_the_two_elastic_limits():
 def test_external_onset_model_departs_from_that_picture_at_intermediate_speeds():
     """The seed's external zone: at v ~ 1e-4 m/s its onset force falls below the relaxed
     elastic one (measured -5 %), which a full model cannot do; the peak stays above it."""
-    res = solver.simulate(scene(1e-4, "external"))
+    res = solvers.simulate(scene(1e-4, "external"))
     low = elastic(G_INF, "external")["F_total"]
     assert res.F_total_detach < 0.97 * low
     assert res.F_peak_total > low
 
 
 def test_prony_series_of_one_arm_is_the_standard_linear_solid():
-    sls = solver.simulate(scene(1e-3))
-    prony = solver.simulate(scene(1e-3, material={
+    sls = solvers.simulate(scene(1e-3))
+    prony = solvers.simulate(scene(1e-3, material={
         "kind": "prony", "G_inf": G_INF, "terms": [{"G": G_1, "tau": TAU_1}]}))
     assert prony.F_peak_total == sls.F_peak_total
     assert prony.t_separation == sls.t_separation
@@ -90,8 +91,8 @@ def test_prony_series_of_one_arm_is_the_standard_linear_solid():
 
 def test_prony_arm_far_faster_than_the_pull_acts_as_relaxed():
     """An arm with tau = 1e-12 s has relaxed long before the pull (milliseconds) notices."""
-    sls = solver.simulate(scene(1e-3))
-    prony = solver.simulate(scene(1e-3, material={
+    sls = solvers.simulate(scene(1e-3))
+    prony = solvers.simulate(scene(1e-3, material={
         "kind": "prony", "G_inf": G_INF,
         "terms": [{"G": G_1, "tau": TAU_1}, {"G": 5e6, "tau": 1e-12}]}))
     # Measured 4e-10: the fast arm only stiffens the first ~1e-12 s.
@@ -99,8 +100,8 @@ def test_prony_arm_far_faster_than_the_pull_acts_as_relaxed():
 
 
 def test_elastic_kind_is_kelvin_voigt_without_viscosity():
-    el = solver.simulate(load_scene(CONFIGS / "separation_elastic.yaml"))
-    kind = solver.simulate(load_scene(CONFIGS / "separation_elastic.yaml",
+    el = solvers.simulate(load_scene(CONFIGS / "separation_elastic.yaml"))
+    kind = solvers.simulate(load_scene(CONFIGS / "separation_elastic.yaml",
                                       overrides=["material={kind: elastic, G: 1.0e6}"]))
     assert kind.F_total_detach == el.F_total_detach
     assert kind.t_separation == el.t_separation
@@ -110,7 +111,7 @@ def test_elastic_kind_is_kelvin_voigt_without_viscosity():
 def test_maxwell_element_step_is_exact_for_a_linear_load(dt):
     """One step of the matrix-exponential update against an ODE solver, for arms far
     faster and far slower than the step."""
-    from pulloff.solver import Problem
+    from pulloff.solvers.onset import Problem
 
     p = Problem(G=1e6, eta=0.0, sigma_c=1e6, delta=1e-6, a=1e-3, v=1e-3,
                 arms=((2e6, 1e-4), (5e5, 7e-3), (3e6, 0.2)))

@@ -8,7 +8,8 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pulloff.scene import (Scene, SceneError, SceneLoader, apply_overrides, load_scene,
+from pulloff.io.scene_file import override
+from pulloff.io.scene_file import (Scene, SceneError, SceneLoader, apply_overrides, load_scene,
                            parse_scene, scene_to_yaml)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -137,11 +138,12 @@ REJECT = [
     ("name=[x]", "name", "['x']", "string"),
     ("schema=2", "schema", "2", "must be one of"),
     ("schema=true", "schema", "true", "boolean"),
-    ("geometry.kind=sphere", "geometry.kind", "'sphere'", "must be one of"),
+    ("geometry.kind=cylinder", "geometry.kind", "'cylinder'", "must be one of"),
     ("material.kind=maxwell", "material.kind", "'maxwell'", "must be one of"),
     ("model.history=lazy", "model.history", "'lazy'", "must be one of"),
     ("material=5", "material", "5", "mapping"),
-    ("loading.speed=1e-3", "loading.speed", "1e-3", "unknown key (allowed: kind, v, h0, machine_stiffness)"),
+    ("loading.speed=1e-3", "loading.speed", "1e-3",
+     "not a parameter of loading kind constant_velocity (it takes v, h0, machine_stiffness)"),
     ("colour=red", "colour", "'red'", "unknown key"),
     ("adhesion.gamma=0.06", "adhesion.gamma", "0.06", "inconsistent"),
 ]
@@ -253,7 +255,7 @@ def test_override_invalid_value_same_error(tmp_path):
 
 def test_with_overrides():
     s = parse_scene(seed())
-    t = s.with_overrides(["loading.v=2e-3"])
+    t = override(s, ["loading.v=2e-3"])
     assert t.loading.v == 2e-3 and s.loading.v == 1e-3
 
 

@@ -6,11 +6,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pulloff.io.scene_file import override
 import pulloff
-from pulloff import sweeps as sw
+from pulloff.studies import sweeps as sw
 from pulloff.cli import main
-from pulloff.scene import load_scene
-from pulloff.solver import simulate
+from pulloff.io.scene_file import load_scene
+from pulloff.solvers import simulate
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 SEED = CONFIGS / "seed_flat_punch.yaml"
@@ -63,9 +64,9 @@ def test_sweep_rows_equal_single_runs_and_run_in_parallel(seed):
     assert t["index"].tolist() == list(range(6))
     assert list(t["model.history"]) == ["exact", "frozen"] * 3
     for r in (0, 3, 5):
-        single = simulate(seed.with_overrides([f"loading.v={float(t['loading.v'][r])!r}",
+        single = simulate(override(seed, [f"loading.v={float(t['loading.v'][r])!r}",
                                                f"model.history={t['model.history'][r]}"]))
-        assert t["F_contact"][r] == single.F_contact_detach
+        assert t["F_contact_detach"][r] == single.F_contact_detach
         assert t["alpha"][r] == single.groups["alpha"]
         assert t["seed_closed_form_F"][r] == single.analytic["seed_closed_form_F"]
     assert np.all(t["status"] == "ok") and np.all(t["detached"])
@@ -75,14 +76,14 @@ def test_a_failing_scene_is_a_row_and_the_sweep_goes_on(seed):
     t = sw.sweep(seed, ["loading.v=1e-3,-1,2e-3"], workers=1).table
     assert list(t["status"]) == ["ok", "failed", "ok"]
     assert "loading.v" in t["message"][1] and "-1" in t["message"][1]
-    assert math.isnan(t["F_contact"][1]) and np.isfinite(t["F_contact"][[0, 2]]).all()
+    assert math.isnan(t["F_contact_detach"][1]) and np.isfinite(t["F_contact_detach"][[0, 2]]).all()
 
 
 def test_varying_one_dugdale_parameter_holds_delta(seed):
     t = sw.sweep(seed, ["adhesion.sigma_c=2e6,5e6"], workers=1).table
-    single = simulate(seed.with_overrides(["adhesion.sigma_c=2e6",
+    single = simulate(override(seed, ["adhesion.sigma_c=2e6",
                                            f"adhesion.gamma={2e6 * seed.adhesion.delta!r}"]))
-    assert t["F_contact"][0] == pytest.approx(single.F_contact_detach, rel=1e-12)
+    assert t["F_contact_detach"][0] == pytest.approx(single.F_contact_detach, rel=1e-12)
 
 
 def test_interrupted_sweep_resumes_without_recomputing(seed, tmp_path, monkeypatch):
@@ -107,7 +108,7 @@ def test_interrupted_sweep_resumes_without_recomputing(seed, tmp_path, monkeypat
     full = sw.sweep(seed, axes, out=out, workers=1)
     assert len(calls) == 2  # only the two missing rows ran
     assert full.table["index"].tolist() == [0, 1, 2, 3, 4]
-    np.testing.assert_array_equal(full.table["F_contact"][:3], kept.table["F_contact"])
+    np.testing.assert_array_equal(full.table["F_contact_detach"][:3], kept.table["F_contact_detach"])
     with pytest.raises(sw.SweepError, match="different sweep"):
         sw.sweep(seed, ["loading.v=log:1e-4:1e-2:4"], out=out, workers=1)
 
@@ -118,7 +119,7 @@ def test_histories_on_request(seed, tmp_path):
     back = pulloff.load(out)
     assert sorted(back.histories) == [0, 1]
     h = back.histories[1]
-    assert h["F_contact"][-1] == pytest.approx(back.table["F_contact"][1], rel=1e-15)
+    assert h["F_contact"][-1] == pytest.approx(back.table["F_contact_detach"][1], rel=1e-15)
 
 
 def test_sweep_on_a_local_dask_cluster(seed):
@@ -129,7 +130,7 @@ def test_sweep_on_a_local_dask_cluster(seed):
         remote = sw.sweep(seed, ["loading.v=log:1e-4:1e-2:4"],
                           scheduler=cluster.scheduler_address)
     local = sw.sweep(seed, ["loading.v=log:1e-4:1e-2:4"], workers=1)
-    np.testing.assert_array_equal(remote.table["F_contact"], local.table["F_contact"])
+    np.testing.assert_array_equal(remote.table["F_contact_detach"], local.table["F_contact_detach"])
 
 
 def test_cli_sweep_and_show(tmp_path, capsys):
@@ -156,14 +157,14 @@ def test_python_api_needs_no_files(tmp_path):
     res = pulloff.run(scene, overrides=["numerics.rtol=1e-4"])
     assert res.detached
     table = pulloff.sweep(scene, ["loading.v=1e-3,1e-2"], workers=1).table
-    assert table["F_contact"][0] == pytest.approx(res.F_contact_detach, rel=1e-3)
+    assert table["F_contact_detach"][0] == pytest.approx(res.F_contact_detach, rel=1e-3)
 
 
 def test_a_sweep_file_without_its_layout_is_a_clear_error(tmp_path):
     import h5py
 
-    from pulloff import h5io
-    from pulloff.sweeps import SweepError, load_sweep
+    from pulloff.io import h5 as h5io
+    from pulloff.studies.sweeps import SweepError, load_sweep
 
     path = tmp_path / "old.h5"
     with h5py.File(path, "w") as f:

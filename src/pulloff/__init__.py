@@ -1,6 +1,11 @@
-"""pulloff: adhesive pull-off of a rigid flat punch from a visco-elastic half-space (MDR + Dugdale).
+"""pulloff: adhesive contact and pull-off of rigid indenters from visco-elastic half-spaces,
+simulated with the method of dimensionality reduction (MDR) and a Dugdale cohesive zone.
 
-The Python entry points mirror the command line and need no files::
+The package reads bottom-up: ``model`` (the scene as data: geometry, rheology, adhesion,
+loading, the output table), ``kernels`` (numba), ``solvers`` (which solver runs a scene, the
+accuracy ladder, observers), ``io`` (scene files, HDF5, console, figures), ``studies`` (sweeps,
+validation) and ``references`` (independent solvers for the tests). The Python entry points
+mirror the command line and need no files::
 
     import pulloff
     res = pulloff.run("configs/seed_flat_punch.yaml", overrides=["loading.v=1e-2"])
@@ -8,41 +13,51 @@ The Python entry points mirror the command line and need no files::
     record = pulloff.load("runs/seed_flat_punch.h5")
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 
-def _scene(scene, overrides=()):
-    from .scene import Scene, load_scene, parse_scene
+def scene(source, overrides=()):
+    """A validated scene from a :class:`pulloff.model.scene.Scene`, a dict in file form or a YAML
+    path, with ``section.key=value`` overrides applied."""
+    from .io.scene_file import load_scene, override, parse_scene
+    from .model.scene import Scene
 
-    if isinstance(scene, Scene):
-        return scene.with_overrides(overrides) if overrides else scene
-    if isinstance(scene, dict):
-        return parse_scene(scene, overrides)
-    return load_scene(scene, overrides)
+    if isinstance(source, Scene):
+        return override(source, overrides) if overrides else source
+    if isinstance(source, dict):
+        return parse_scene(source, overrides)
+    return load_scene(source, overrides)
 
 
-def run(scene, overrides=(), progress: bool = False):
+def run(source, overrides=(), progress: bool = False):
     """Simulate a scene (a Scene, a dict in file form, or a YAML path); SI
-    :class:`pulloff.solver.Result`."""
-    from .solver import simulate
+    :class:`pulloff.solvers.result.Result`."""
+    from . import solvers
 
-    return simulate(_scene(scene, overrides), progress=progress)
+    hook = None
+    if progress:
+        from .io.console import progress_bar
+
+        hook = lambda desc, total=None: progress_bar(True, desc, total)  # noqa: E731
+    return solvers.simulate(scene(source, overrides), progress=hook)
 
 
-def sweep(scene, axes, overrides=(), **options):
+def sweep(source, axes, overrides=(), **options):
     """Run a scene over the product of ``axes`` (``"section.key=log:a:b:n"`` strings or
-    :class:`pulloff.sweeps.Axis`); options as :func:`pulloff.sweeps.sweep`."""
-    from .sweeps import sweep as _sweep
+    :class:`pulloff.studies.sweeps.Axis`); options as :func:`pulloff.studies.sweeps.sweep`."""
+    from .studies.sweeps import sweep as _sweep
 
-    return _sweep(_scene(scene, overrides), axes, **options)
+    if isinstance(axes, str):  # one axis given as one string, not a list of characters
+        axes = [axes]
+    return _sweep(scene(source, overrides), axes, **options)
 
 
 def load(path):
     """Read a run file (plain dict of numpy arrays and numbers) or a sweep file
-    (:class:`pulloff.sweeps.SweepResult`)."""
-    from . import h5io
-    from .sweeps import load_sweep
+    (:class:`pulloff.studies.sweeps.SweepResult`)."""
+    from .io import h5
+    from .studies.sweeps import load_sweep
 
-    with h5io.open_for_reading(path) as f:
+    with h5.open_for_reading(path) as f:
         kind = f.attrs.get("kind")
-    return load_sweep(path) if kind == "sweep" else h5io.load(path)
+    return load_sweep(path) if kind == "sweep" else h5.load(path)

@@ -11,9 +11,11 @@ from . import __version__
 
 
 def _cmd_run(args) -> int:
-    from . import h5io, report, scene as scene_mod, solver
+    from . import solvers
+    from .io import console as report, h5 as h5io
+    from .io.scene_file import load_scene, scene_to_yaml
 
-    scene = scene_mod.load_scene(args.config, overrides=args.set or ())
+    scene = load_scene(args.config, overrides=args.set or ())
     out = Path(args.output) if args.output else None
     if out is None and scene.output.path:
         out = Path(scene.output.path)
@@ -23,9 +25,8 @@ def _cmd_run(args) -> int:
     with h5io.atomic_file(out) as f:
         # A fixed-step run streams its history into the file while it runs.
         stream = h5io.HistoryStream(f) if scene.numerics.steps is not None else None
-        result = solver.simulate(scene, progress=_show_progress(args),
-                                 stream=stream)
-        record = h5io.result_to_record(result, scene_mod.scene_to_yaml(scene))
+        result = solvers.simulate(scene, progress=_progress(args), stream=stream)
+        record = h5io.result_to_record(result, scene_to_yaml(scene))
         h5io.fill(f, record, history_streamed=result.history_streamed)
         if stream is not None:
             record["history_rows_in_file"] = stream.rows
@@ -33,7 +34,7 @@ def _cmd_run(args) -> int:
     if args.no_plot:
         print(f"  wrote {out}")
     else:
-        from . import plots
+        from .io import plots
 
         png = out.with_suffix(".png")
         plots.plot_history(record, png, title=scene.name or Path(args.config).stem)
@@ -46,9 +47,11 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from . import report, scene as scene_mod, sweeps as sweep_mod
+    from .io import console as report
+    from .io.scene_file import load_scene
+    from .studies import sweeps as sweep_mod
 
-    scene = scene_mod.load_scene(args.config, overrides=args.set or ())
+    scene = load_scene(args.config, overrides=args.set or ())
     axes = [sweep_mod.parse_axis(text) for text in args.vary]
     _check_writable(Path(args.output), "-o")
     start = time.perf_counter()
@@ -65,6 +68,15 @@ def _show_progress(args) -> bool:
     return not args.quiet and sys.stderr.isatty()
 
 
+def _progress(args):
+    """The progress hook of a run (:class:`pulloff.solvers.observers.Observers`)."""
+    from .io.console import progress_bar
+
+    if not _show_progress(args):
+        return None
+    return lambda desc, total=None: progress_bar(True, desc, total)
+
+
 def _check_writable(path: Path, key: str) -> None:
     """Fail before any work if the result could not be written."""
     if path.is_dir():
@@ -75,7 +87,7 @@ def _check_writable(path: Path, key: str) -> None:
 
 
 def _cmd_validate(args) -> int:
-    from . import validate
+    from .studies import validate
 
     report_path = validate.validate(args.output, rtol=args.rtol, small=args.small,
                                     workers=args.workers,
@@ -89,10 +101,10 @@ _SHOWN_ROWS = 100_000
 
 
 def _cmd_show(args) -> int:
-    from . import h5io, report
+    from .io import console as report, h5 as h5io
 
     if _is_sweep(args.file):
-        from .sweeps import load_sweep
+        from .studies.sweeps import load_sweep
 
         print(report.format_sweep(load_sweep(args.file)))
         return 0
@@ -104,18 +116,18 @@ def _cmd_show(args) -> int:
 
 
 def _is_sweep(path) -> bool:
-    from . import h5io
+    from .io import h5 as h5io
 
     with h5io.open_for_reading(path) as f:
         return f.attrs.get("kind") == "sweep"
 
 
 def _cmd_plot(args) -> int:
-    from . import h5io, plots
+    from .io import h5 as h5io, plots
 
     png = Path(args.output) if args.output else Path(args.file).with_suffix(".png")
     if _is_sweep(args.file):
-        from .sweeps import load_sweep
+        from .studies.sweeps import load_sweep
 
         plots.plot_sweep(load_sweep(args.file), png, title=str(args.file))
     else:
@@ -183,7 +195,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from .scene import SceneError
+    from .model.scene import SceneError
 
     args = build_parser().parse_args(argv)
     try:

@@ -34,10 +34,15 @@ def _fmt(value, unit=""):
 
 
 def _rel(model, reference):
+    """``(model - reference)/|reference|`` as a percentage, or the ratio where they are more
+    than a factor 10 apart (a closed form outside its range says nothing in percent)."""
     if not all(isinstance(x, (int, float)) and math.isfinite(x) for x in (model, reference)):
         return "n/a"
     if reference == 0:
         return "n/a"
+    ratio = model / reference
+    if not 0.1 <= ratio <= 10.0:
+        return f"x{ratio:.3g}"
     return f"{(model - reference) / abs(reference):+.2%}"
 
 
@@ -53,7 +58,7 @@ def format_table(record: dict, title: str | None = None) -> str:
     if title:
         lines.append(title)
     lines.append(f"  model: history={s.get('history', 'exact')}   alpha = {_fmt(s['alpha'])}   "
-                 f"chi = {_fmt(s['chi'])}   V = {_fmt(s['V'])}")
+                 f"chi = {_fmt(s['chi'])}   V = {_fmt(s['V'])}   solver: {s.get('solver', '?')}")
     if not record.get("complete", True):
         lines.append(f"  INCOMPLETE: interrupted at t = {_fmt(s['t_end'], 's')}; the history "
                      f"holds what was computed until then")
@@ -103,8 +108,11 @@ def format_table(record: dict, title: str | None = None) -> str:
             ("peak F_total", f"{_fmt(s.get('F_peak_total'), 'N')} at "
                              f"{_fmt(s.get('t_peak_total'), 's')}"),
             ("peak / onset F_total", _rel(s.get("F_peak_total"), F_on)),
-            ("observed order (step)", _fmt(s.get("observed_order"))),
         ]
+        order = s.get("observed_order")
+        if isinstance(order, float) and math.isfinite(order) and order >= 0.5:
+            # Only where the last three levels converge; elsewhere a number would mislead.
+            rows.append(("observed order (step)", _fmt(order)))
         for label, text in rows:
             lines.append(f"    {label:<28} {text:>30}")
     for note in filter(None, str(s.get("notes", "")).split("; ")):
@@ -139,7 +147,7 @@ def format_sweep(result, max_rows: int = 40) -> str:
         if r != previous + 1:
             lines.append(f"  ... {n - max_rows} rows not shown ...")
         previous = r
-        F = table["F_contact"][r]
+        F = table["F_contact_detach"][r]
         cells = [_short(table[k][r]) for k in keys] + [
             _short(table["alpha"][r]), _short(table["chi"][r]), _short(F),
             _rel(float(table["seed_closed_form_F"][r]), float(F)),

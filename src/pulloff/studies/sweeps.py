@@ -24,28 +24,23 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from . import h5io
+from ..io import h5 as h5io
+from ..model import outputs
+from ..model.scene import unit_of
 
-#: Result columns of the table (beside the axes): name -> unit.
-RESULT_COLUMNS = {
-    "alpha": "1", "chi": "1", "V": "1",
-    "t_detach": "s", "h_detach": "m", "b_detach": "m", "zone_ratio_detach": "1",
-    "F_contact": "N", "F_total": "N",
-    "seed_linearised_t_detach": "s", "seed_linearised_F": "N", "seed_closed_form_F": "N",
-    "kendall_F": "N", "viscous_F": "N", "elastic_F_contact": "N", "elastic_F_total": "N",
-    "error_estimate": "1", "n_steps": "1", "wall_time": "s",
-}
-TEXT_COLUMNS = ("status", "message")
-#: Units of the scene values an axis may vary.
-SCENE_UNITS = {
-    "geometry.radius": "m", "material.G": "Pa", "material.eta": "Pa s",
-    "adhesion.sigma_c": "Pa", "adhesion.delta": "m", "adhesion.gamma": "J/m^2",
-    "loading.v": "m/s", "loading.h0": "m", "numerics.rtol": "1", "numerics.t_max": "s",
-}
+#: Result columns of the table (beside the axes): every numeric summary and closed-form
+#: quantity of the output table (:mod:`pulloff.model.outputs`), name -> unit.
+RESULT_COLUMNS = {q.name: q.unit for q in outputs.OUTPUTS
+                  if q.group in ("summary", "analytic") and not q.text}
+TEXT_COLUMNS = ("status", "message") + tuple(
+    q.name for q in outputs.OUTPUTS if q.group in ("summary", "analytic") and q.text
+    and q.name != "detached")
 #: When a sweep varies one Dugdale parameter, the one held fixed is the first of these that
 #: is not varied (so varying sigma_c keeps delta and changes gamma).
 _ADHESION_KEEP_ORDER = ("delta", "sigma_c", "gamma")
 FLUSH_SECONDS = 2.0
+#: Key of a row's history arrays (``--histories``); ``history`` is the model.history column.
+ARRAYS = "history_arrays"
 
 
 class SweepError(ValueError):
@@ -69,9 +64,7 @@ def parse_axis(text: str) -> Axis:
     ``log`` spaces ``n`` values evenly in log10 between ``a`` and ``b`` (both > 0); list values
     are read as YAML scalars (numbers as numbers, ``frozen`` as a string).
     """
-    from .scene import SceneLoader
-
-    import yaml
+    from ..io.scene_file import read_yaml
 
     key, sep, spec = text.partition("=")
     key = key.strip()
@@ -103,7 +96,7 @@ def parse_axis(text: str) -> Axis:
         raise SweepError(f"--vary {text!r}: empty list")
     values = []
     for item in items:
-        value = yaml.load(item, Loader=SceneLoader)
+        value = read_yaml(item, where=f"--vary {text!r}")
         values.append(float(value) if isinstance(value, int) and not isinstance(value, bool)
                       else value)
     return Axis(key, tuple(values))
@@ -139,46 +132,33 @@ def _adhesion_drops(axes: Sequence[Axis]) -> list[str]:
 def run_point(base_yaml: str, overrides: Sequence[str], history: bool = False,
               drop_adhesion: Sequence[str] = ()) -> dict:
     """Run one scene of a sweep; never raises (a failure is a row with its message)."""
-    import yaml
-
-    from .scene import SceneLoader, parse_scene
-    from .solver import simulate
+    from .. import solvers
+    from ..io.scene_file import parse_scene, read_yaml
 
     row = {"status": "ok", "message": ""}
     try:
-        data = yaml.load(base_yaml, Loader=SceneLoader)
+        data = read_yaml(base_yaml)
         for name in drop_adhesion:
             data["adhesion"].pop(name, None)
-        scene = parse_scene(data, overrides=overrides)
-        res = simulate(scene)
+        res = solvers.simulate(parse_scene(data, overrides=overrides))
     except Exception as exc:  # a failed scene is data, not the end of the sweep
         row.update(status="failed", message=f"{type(exc).__name__}: {exc}")
         return row
     if not res.complete:
         # Ctrl-C reached the stepper: a cut-short scene is not a row; stop like the parent.
         raise KeyboardInterrupt
-    row.update(res.groups)
-    row.update(
-        detached=res.detached, t_detach=res.t_detach, h_detach=res.h_detach,
-        b_detach=res.b_detach, zone_ratio_detach=res.zone_ratio_detach,
-        F_contact=res.F_contact_detach, F_total=res.F_total_detach,
-        error_estimate=res.error_estimate, n_steps=res.n_steps, wall_time=res.wall_time,
-    )
-    for key in ("seed_linearised_t_detach", "seed_linearised_F", "seed_closed_form_F",
-                "kendall_F", "viscous_F", "elastic_F_contact", "elastic_F_total"):
-        row[key] = res.analytic[key]
+    row.update(res.summary)
+    row.update(res.analytic)
     if history:
-        row["history"] = {name: np.asarray(v) for name, v in res.history.items()}
+        row[ARRAYS] = {name: np.asarray(v) for name, v in res.history.items()}
     return row
 
 
 def _check_axes(base_yaml: str, axes: Sequence[Axis]) -> None:
     """Reject axes naming keys the scene does not have, before any work."""
-    import yaml
+    from ..io.scene_file import read_yaml
 
-    from .scene import SceneLoader
-
-    base = yaml.load(base_yaml, Loader=SceneLoader)
+    base = read_yaml(base_yaml)
     seen = set()
     for axis in axes:
         if axis.key in seen:
@@ -231,7 +211,7 @@ def sweep_points(scene, keys: Sequence[str], points: Sequence[tuple], out=None,
 
     For sets of scenes that are not a product grid (e.g. a rectangle in ``(alpha, chi)``).
     """
-    from .scene import scene_to_yaml
+    from ..io.scene_file import scene_to_yaml
 
     base_yaml = scene_to_yaml(scene)
     keys = list(keys)
@@ -353,7 +333,7 @@ def _table(layout: _Layout, rows):
         table[name] = np.asarray([rows[i].get(name, math.nan) for i in indices], dtype=float)
     table["detached"] = np.asarray([bool(rows[i].get("detached", False)) for i in indices])
     for name in TEXT_COLUMNS:
-        table[name] = np.asarray([rows[i][name] for i in indices], dtype=object)
+        table[name] = np.asarray([str(rows[i].get(name, "")) for i in indices], dtype=object)
     return table
 
 
@@ -374,13 +354,13 @@ def _write(out, layout: _Layout, rows) -> None:
                                       dtype=h5py.string_dtype())
             else:
                 ds = g.create_dataset(name, data=values)
-            ds.attrs["unit"] = RESULT_COLUMNS.get(name, SCENE_UNITS.get(name, ""))
-        hist = [i for i in sorted(rows) if "history" in rows[i]]
+            ds.attrs["unit"] = RESULT_COLUMNS.get(name) or unit_of(name)
+        hist = [i for i in sorted(rows) if ARRAYS in rows[i]]
         if hist:
             h = f.create_group("histories")
             for i in hist:
                 gi = h.create_group(f"{i:06d}")
-                for name, values in rows[i]["history"].items():
+                for name, values in rows[i][ARRAYS].items():
                     ds = gi.create_dataset(name, data=values)
                     ds.attrs["unit"] = h5io.HISTORY_UNITS[name]
 
@@ -390,14 +370,14 @@ def _read_rows(f) -> dict:
     indices = g["index"][()]
     rows = {}
     for r, i in enumerate(indices):
-        row = {name: float(g[name][r]) for name in RESULT_COLUMNS}
+        row = {name: float(g[name][r]) for name in RESULT_COLUMNS if name in g}
         row["detached"] = bool(g["detached"][r])
-        for name in TEXT_COLUMNS:
+        for name in (n for n in TEXT_COLUMNS if n in g):
             value = g[name][r]
             row[name] = value.decode() if isinstance(value, bytes) else str(value)
         if "histories" in f and f"{i:06d}" in f["histories"]:
             gi = f["histories"][f"{i:06d}"]
-            row["history"] = {name: gi[name][()] for name in gi}
+            row[ARRAYS] = {name: gi[name][()] for name in gi}
         rows[int(i)] = row
     return rows
 
@@ -425,7 +405,7 @@ def _resume(out, layout: _Layout) -> dict:
 
 
 def _as_result(layout: _Layout, rows) -> SweepResult:
-    histories = {i: rows[i]["history"] for i in sorted(rows) if "history" in rows[i]}
+    histories = {i: rows[i][ARRAYS] for i in sorted(rows) if ARRAYS in rows[i]}
     return SweepResult(layout.base_yaml, [axis.to_json() for axis in layout.axes],
                        _table(layout, rows), histories)
 

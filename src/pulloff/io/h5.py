@@ -22,58 +22,22 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from . import __version__
+from .. import __version__
+from ..model import outputs
 
 SCHEMA_VERSION = 1
 
-HISTORY_UNITS = {"t": "s", "h": "m", "a": "m", "b": "m", "gap": "m", "F_contact": "N",
-                 "F_total": "N"}
-
-SUMMARY_UNITS = {
-    "detached": "", "t_detach": "s", "h_detach": "m", "b_detach": "m", "zone_ratio_detach": "1",
-    "F_contact_detach": "N", "F_total_detach": "N", "alpha": "1", "chi": "1", "V": "1",
-    "n_elements": "1", "n_steps": "1", "wall_time": "s", "error_estimate": "1",
-    "t_end": "s", "history": "", "notes": "", "until": "", "cohesive_zone": "",
-    "t_separation": "s", "F_peak_contact": "N", "F_peak_total": "N", "t_peak_contact": "s",
-    "t_peak_total": "s", "observed_order": "1",
-}
-
-ANALYTIC_UNITS = {
-    "seed_linearised_t_detach": "s", "seed_linearised_F": "N",
-    "seed_closed_form_t_detach": "s", "seed_closed_form_F": "N",
-    "seed_closed_form_branch": "", "kendall_F": "N", "viscous_F": "N",
-    "elastic_F_contact": "N", "elastic_F_total": "N", "elastic_b": "m",
-    "elastic_instant_F_contact": "N", "elastic_instant_F_total": "N",
-}
+HISTORY_UNITS = outputs.units("history")
+SUMMARY_UNITS = outputs.units("summary")
+ANALYTIC_UNITS = outputs.units("analytic")
 
 
 def result_to_record(result, scene_yaml: str) -> dict:
-    """The plain-dict view of a :class:`pulloff.solver.Result` that files also load into."""
-    summary = {
-        "detached": bool(result.detached),
-        "t_detach": result.t_detach,
-        "h_detach": result.h_detach,
-        "b_detach": result.b_detach,
-        "zone_ratio_detach": result.zone_ratio_detach,
-        "F_contact_detach": result.F_contact_detach,
-        "F_total_detach": result.F_total_detach,
-        **{name: float(value) for name, value in result.groups.items()},
-        "n_elements": result.n_elements,
-        "n_steps": result.n_steps,
-        "wall_time": result.wall_time,
-        "error_estimate": result.error_estimate,
-        "t_end": result.t_end,
-        "history": result.history_model,
-        "notes": "; ".join(result.notes),
-        "until": result.until,
-        "cohesive_zone": result.cohesive_zone,
-        "t_separation": result.t_separation,
-        "F_peak_contact": result.F_peak_contact,
-        "F_peak_total": result.F_peak_total,
-        "t_peak_contact": result.t_peak_contact,
-        "t_peak_total": result.t_peak_total,
-        "observed_order": result.observed_order,
-    }
+    """The plain-dict view of a :class:`pulloff.solvers.result.Result` that files also load
+    into."""
+    summary = {name: (bool(value) if isinstance(value, (bool, np.bool_)) else
+                      int(value) if isinstance(value, (int, np.integer)) else value)
+               for name, value in result.summary.items()}
     return {
         "scene": scene_yaml,
         "summary": summary,

@@ -77,7 +77,7 @@ def plot_alpha_tstar(curves: dict, path) -> Path:
     """The seed's Figs. 8/10: alpha against t*, eq. 53 and its approximations vs simulation."""
     import numpy as np
 
-    from . import analytic
+    from ..model import analytic
 
     t = np.logspace(-3, 2.5, 400)
     fig, (ax, ax_dev) = plt.subplots(1, 2, figsize=(11.0, 4.6), constrained_layout=True)
@@ -121,7 +121,7 @@ def plot_taylor(path) -> Path:
     """The seed's Fig. 9: Taylor polynomials T1-T5 of eq. 53's right side."""
     import numpy as np
 
-    from . import analytic
+    from ..model import analytic
 
     t = np.linspace(0.0, 3.0, 300)
     fig, ax = plt.subplots(figsize=(6.0, 4.4), constrained_layout=True)
@@ -140,15 +140,15 @@ def plot_force_speed(speeds, material: dict, path) -> Path:
     """Pull-off force against speed: simulation, the seed's closed form, the two limits."""
     import numpy as np
 
-    from . import analytic
+    from ..model import analytic
 
     t = speeds.table
     v = t["loading.v"]
     e = material
     elastic = analytic.elastic_mdr_dugdale(e["G"], e["sigma_c"], e["delta"], e["a"])
     fig, ax = plt.subplots(figsize=(6.8, 4.8), constrained_layout=True)
-    ax.loglog(v, t["F_contact"], "o-", ms=4, label="simulation F_contact")
-    ax.loglog(v, t["F_total"], "s--", ms=3, label="simulation F_total")
+    ax.loglog(v, t["F_contact_detach"], "o-", ms=4, label="simulation F_contact")
+    ax.loglog(v, t["F_total_detach"], "s--", ms=3, label="simulation F_total")
     ax.loglog(v, t["seed_closed_form_F"], "k-", lw=1.0, label="seed closed form (64/89)")
     vv = np.logspace(np.log10(v.min()), np.log10(v.max()), 200)
     ax.loglog(vv, 8 * e["eta"] * vv * e["a"], "k:", lw=1.0, label="8 eta v a (eq. 96)")
@@ -222,20 +222,20 @@ def plot_sweep(result, path, title: str | None = None) -> Path:
         name = ", ".join(f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}"
                          for k, v in zip(others, label)) or "simulation"
         ok = t["status"][rows] == "ok"
-        ax.plot(t[x_key][rows][ok], t["F_contact"][rows][ok], "o-", ms=3.5, color=f"C{i}",
+        ax.plot(t[x_key][rows][ok], t["F_contact_detach"][rows][ok], "o-", ms=3.5, color=f"C{i}",
                 label=name)
         ax.plot(t[x_key][rows][ok], t["seed_closed_form_F"][rows][ok], "--", lw=1.0,
                 color=f"C{i}")
     x = t[x_key][t["status"] == "ok"]
     if x.size and np.all(x > 0) and x.max() / x.min() > 20:
         ax.set_xscale("log")
-    positive = t["F_contact"][t["status"] == "ok"]
+    positive = t["F_contact_detach"][t["status"] == "ok"]
     if positive.size and np.all(positive > 0) and positive.max() / positive.min() > 20:
         ax.set_yscale("log")
     ax.plot([], [], "k--", lw=1.0, label="seed closed form (eqs. 64/89)")
-    from .sweeps import SCENE_UNITS
+    from ..model.scene import unit_of
 
-    ax.set_xlabel(f"{x_key} [{SCENE_UNITS.get(x_key, '-')}]")
+    ax.set_xlabel(f"{x_key} [{unit_of(x_key) or '-'}]")
     ax.set_ylabel("F_contact at detachment [N]")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)

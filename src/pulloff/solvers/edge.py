@@ -24,13 +24,20 @@ whenever they move, so both edges are resolved between the old nodes, not snappe
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import brentq
 
-from . import kernels
-from .report import progress_bar
+from ..kernels import edge as kernels
+from ..kernels.onset import linear_load_weights
+from ..model import analytic
+from . import levels as ladder
+from .base import Solver, flat_punch_pull, problem as problem_line
+from .frozen import frozen_detach_time
+from .problem import Problem
+from .result import Result
 
 PHASE_BONDED, PHASE_RECEDING, PHASE_ZONE_ONLY, PHASE_SEPARATED = 0, 1, 2, 3
 
@@ -107,7 +114,7 @@ class _KelvinVoigt:
 
     def prepare(self, dt):
         self.dt = dt
-        self.decay, self.w_old, self.w_new = kernels.linear_load_weights(self.k, self.c, dt)
+        self.decay, self.w_old, self.w_new = linear_load_weights(self.k, self.c, dt)
 
     def _speed(self, h_old, h_new):
         if self.rigid:
@@ -191,7 +198,7 @@ class _Maxwell:
         self.gamma_old = X[:m, m] - self.gamma_new
         self.w_new = (1.0 + float(np.dot(self.k_arms, self.gamma_new))) / self.k_total
         # Bonded dashpots under a lift linear over the step: E + tau dE/dt = h.
-        self.bond_weights = np.array([kernels.linear_load_weights(1.0, tau, dt)
+        self.bond_weights = np.array([linear_load_weights(1.0, tau, dt)
                                       for tau in self.taus])
 
     def _bond_after(self, h_old, h_new):
@@ -638,62 +645,119 @@ def outputs(run: PropagationRun, internal: bool) -> np.ndarray:
     return np.array([run.t_onset, run.t_separation, Fc_on, Ft_on, Fc, Ft], dtype=float)
 
 
+#: The load's sqrt at the moving zone ends limits the step to order 1.5: a higher measured
+#: order is a pre-asymptotic accident and must not shrink the estimate.
+ORDER = ladder.Order(1.0, 1.5)
+
+
 def simulate_levels(problem, rtol: float, t_scale: float, t_limit: float, internal: bool,
-                    until: str, progress: bool = False, machine: float | None = None):
-    """Runs at ``n = 50, 100, 200, ...`` until the Richardson estimate of the finest level's
-    relative error (see :func:`_richardson`) is below ``rtol / 2`` or a level would exceed
-    ``MAX_LEVEL_STEPS``. Returns ``(finest run, estimate, observed order)``."""
-    levels = []
-    n = 50
-    estimate, order = math.nan, math.nan
-    while True:
-        with progress_bar(progress, f"n = {n}") as update:
-            run = run_propagation(problem, n, t_scale, t_limit, internal, until,
-                                  max_steps=MAX_LEVEL_STEPS, progress=update, machine=machine)
-        levels.append(run)
-        if run.interrupted:
-            return run, math.nan, math.nan
-        if len(levels) >= 3:
-            estimate, order = _richardson([outputs(r, internal) for r in levels[-3:]])
-            if estimate <= 0.5 * rtol:
-                return run, estimate, order
+                    until: str, progress, machine: float | None = None):
+    """Runs at ``n = 50, 100, 200, ...`` (:func:`pulloff.solvers.levels.refine`) until the
+    Richardson estimate of the finest level's relative error is below ``rtol / 2`` or a level
+    would exceed ``MAX_LEVEL_STEPS``. Returns ``(finest run, estimate, observed order)``."""
+
+    def level(n):
+        with progress(f"n = {n}", None) as update:
+            return run_propagation(problem, n, t_scale, t_limit, internal, until,
+                                   max_steps=MAX_LEVEL_STEPS, progress=update, machine=machine)
+
+    result = ladder.refine(
+        level, lambda run: outputs(run, internal), rtol, 50, ORDER,
         # The next level takes about twice the steps of this one.
-        if 2 * run.n_steps > MAX_LEVEL_STEPS or run.n_steps >= MAX_LEVEL_STEPS:
-            if len(levels) < 3 and len(levels) >= 2:
-                values = [outputs(r, internal) for r in levels[-2:]]
-                estimate = _relative_spread(values[0], values[1]) / 3.0
-            return run, estimate, order
-        n *= 2
+        can_refine=lambda run, n: 2 * run.n_steps <= MAX_LEVEL_STEPS
+        and run.n_steps < MAX_LEVEL_STEPS, interrupted=lambda run: run.interrupted)
+    return result.finest, result.estimate, result.order
 
 
-def _relative_spread(a, b):
-    mask = np.isfinite(a) & np.isfinite(b) & (b != 0)
-    if not np.any(mask):
-        return 0.0 if np.array_equal(np.isnan(a), np.isnan(b)) else math.inf
-    return float(np.max(np.abs(a[mask] - b[mask]) / np.abs(b[mask])))
+class EdgeSolver(Solver):
+    """The moving contact edge: separation, the finite punch, Maxwell solids, a compliant
+    machine (MODEL.md section 6)."""
+
+    name = "edge"
+    summary = "moving-edge stepper (receding contact edge, any rheology, machine spring)"
+
+    def unsupported(self, scene) -> list[str]:
+        out = flat_punch_pull(scene, "moving-edge", zones=("external", "internal"), machine=True)
+        if scene.model.history != "exact":
+            out.append(problem_line(
+                "model.history", scene.model.history, "the seed's frozen load history (eq. 31) "
+                "is a Kelvin-Voigt onset closed form; the moving-edge solver steps the exact "
+                "history" + (f" of a {scene.material.kind}" if scene.material.kind not in
+                             ("kelvin_voigt", "elastic") else "")))
+        if scene.numerics.steps is not None:
+            out.append(problem_line(
+                "numerics.steps", scene.numerics.steps, "fixed-step runs cover the seed's onset "
+                "only; a moving contact edge is refined from numerics.rtol"))
+        if scene.output.snapshots:
+            out.append(problem_line(
+                "output.snapshots", list(scene.output.snapshots), "the moving-edge solver "
+                "stores no displacement profiles"))
+        return out
+
+    def solve(self, scene, observers) -> Result:
+        return _solve(scene, observers)
 
 
-def _richardson(values):
-    """``(estimate, measured order)`` of the finest of three levels (step ratio 2), for the
-    output that changed most: Richardson with the measured order clipped to [1, 1.5]; below
-    an order of 0.5 the levels are not converging and the estimate is the larger of their
-    last two differences."""
-    v0, v1, v2 = values
-    if not np.array_equal(np.isnan(v1), np.isnan(v2)):
-        return math.inf, math.nan  # separation found on one level only: not resolved
-    mask = np.isfinite(v2) & (v2 != 0)
-    d_last = np.abs(v2 - v1)[mask] / np.abs(v2[mask])
-    d_prev = np.abs(v1 - v0)[mask] / np.abs(v2[mask])
-    if d_last.size == 0:
-        return 0.0, math.nan
-    worst = int(np.argmax(d_last))
-    if d_last[worst] == 0.0:
-        return 0.0, math.nan
-    measured = math.log2(d_prev[worst] / d_last[worst]) if d_prev[worst] > 0 else 1.5
-    if measured < 0.5:
-        # The levels are not (yet) converging: no extrapolation, only what they show.
-        return float(max(d_last[worst], d_prev[worst])), measured
-    # The load's sqrt at the zone ends limits the step to order 1.5: a higher measured
-    # order is a pre-asymptotic accident and must not shrink the estimate.
-    order = min(1.5, max(1.0, measured))
-    return float(d_last[worst] / (2.0**order - 1.0)), measured
+def _solve(scene, observers) -> Result:
+    """A run with a receding contact edge, in SI."""
+    wall_start = time.perf_counter()
+    problem = Problem.from_scene(scene)
+    T = problem.time_scale
+    t_limit = math.inf if scene.numerics.t_max is None else scene.numerics.t_max / T
+    t_frozen = frozen_detach_time(problem, t_limit)
+    rtol = scene.numerics.rtol
+    internal = scene.geometry.cohesive_zone == "internal"
+    until = scene.model.until
+    t_scale = t_frozen if math.isfinite(t_frozen) and t_frozen > 0 else 1.0
+    if not math.isfinite(t_limit):
+        t_limit = DEFAULT_SPAN * t_scale
+    machine = None
+    if scene.loading.machine_stiffness is not None:
+        # k_m delta / (sigma_c R^2): spring force per unit stretch, in the solver's units.
+        machine = (scene.loading.machine_stiffness * problem.delta
+                   / (problem.sigma_c * problem.a ** 2))
+    run, estimate, order = simulate_levels(problem, rtol, t_scale, t_limit, internal, until,
+                                           observers.progress, machine)
+    notes = list(run.notes)
+    if not estimate <= rtol and not run.interrupted:
+        notes.append(f"not converged: error estimate {estimate:.2g} above rtol {rtol:g} at "
+                     f"the step cap ({MAX_LEVEL_STEPS} steps per level)")
+    if (until == "separation" and math.isnan(run.t_separation) and not run.interrupted
+            and not run.notes):
+        notes.append(f"no separation before t_max = {run.t[-1] * T:.6g} s")
+    summary = _summary(scene, problem, run, internal)
+    summary.update(error_estimate=float(estimate), observed_order=float(order),
+                   wall_time=time.perf_counter() - wall_start)
+    return Result.build(summary, analytic.predictions(scene),
+                        _history(problem, run, observers), notes=notes,
+                        complete=not run.interrupted, problem=problem)
+
+
+def _history(problem, run, observers) -> dict:
+    rows = observers.kept_rows(run.t.size, np.arange(run.t.size))
+    R, force = problem.a, problem.sigma_c * problem.a ** 2
+    return {"t": run.t[rows] * problem.time_scale,
+            "h": problem.delta * run.h[rows],  # behind a spring the lift lags the driver
+            "a": R * run.a[rows], "b": R * run.b[rows], "gap": problem.delta * run.gap[rows],
+            "F_contact": force * run.F_contact[rows], "F_total": force * run.F_total[rows]}
+
+
+def _summary(scene, problem, run, internal) -> dict:
+    T, R, force = problem.time_scale, problem.a, problem.sigma_c * problem.a ** 2
+    a_on, b_on, F_c_on, F_t_on = onset_state(run, internal)
+    (t_pc, F_pc), (t_pt, F_pt) = peaks(run, internal)
+    detached = math.isfinite(run.t_onset)
+    out = {"detached": detached, "solver": "edge", "history": scene.model.history,
+           "until": scene.model.until, "cohesive_zone": scene.geometry.cohesive_zone,
+           "n_elements": int(run.n_elements), "n_steps": int(run.n_steps),
+           "t_end": float(run.t[-1] * T), "t_separation": float(run.t_separation * T),
+           "F_peak_contact": float(F_pc * force), "F_peak_total": float(F_pt * force),
+           "t_peak_contact": float(t_pc * T), "t_peak_total": float(t_pt * T),
+           **problem.groups}
+    if detached:
+        out.update(t_detach=run.t_onset * T,
+                   h_detach=problem.delta * float(np.interp(run.t_onset, run.t, run.h)),
+                   b_detach=R * b_on,
+                   zone_ratio_detach=(b_on - a_on) / a_on if a_on > 0 else math.nan,
+                   F_contact_detach=force * F_c_on, F_total_detach=force * F_t_on)
+    return out

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import analytic
-from .scene import group_values, parse_scene, scene_from_groups
+from ..io.scene_file import group_values, parse_scene, scene_from_groups
+from ..model import analytic
 from .sweeps import Axis, sweep, sweep_points
 
 #: The seed's claimed worst error of its combined closed form (eq. 90).
@@ -96,7 +96,7 @@ def _labelled(result, labels):
     eta = t["material.eta"]
     t_star = t["t_detach"] * 1e6 / eta  # base G = 1e6 Pa
     return {"alpha": alpha, "chi": chi, "history": history, "t_star": t_star,
-            "F": t["F_contact"], "F_closed": t["seed_closed_form_F"],
+            "F": t["F_contact_detach"], "F_closed": t["seed_closed_form_F"],
             "status": t["status"]}
 
 
@@ -113,8 +113,8 @@ def validate(out_dir="validation", rtol: float = 1e-5, small: bool = False, work
     numbers = summarise(curves, emap, speeds)
     numbers.update(rtol=rtol, elapsed=elapsed, small=small,
                    n_scenes=sum(len(x) for x in (curves["F"], emap["F"],
-                                                 speeds.table["F_contact"])))
-    from . import plots
+                                                 speeds.table["F_contact_detach"])))
+    from ..io import plots
 
     plots.plot_alpha_tstar(curves, out / "alpha_tstar.png")
     plots.plot_taylor(out / "taylor.png")
@@ -163,7 +163,7 @@ def summarise(curves: dict, emap: dict, speeds) -> dict:
 
     e = ELASTOMER
     t = speeds.table
-    v, F = t["loading.v"], t["F_contact"]
+    v, F = t["loading.v"], t["F_contact_detach"]
     elastic = analytic.elastic_mdr_dugdale(e["G"], e["sigma_c"], e["delta"], e["a"])
     n["speed_slowest"] = (float(v[0]), float(F[0] / elastic["F_contact"] - 1))
     n["speed_fastest"] = (float(v[-1]), float(F[-1] / (8 * e["eta"] * v[-1] * e["a"]) - 1))

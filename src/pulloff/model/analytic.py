@@ -574,3 +574,46 @@ def cohesive_force(sigma_c, a, b):
     # (b - a) is exact for b <= 2a (Sterbenz), so S keeps full relative precision for thin zones
     S = np.sqrt((b - a) * (b + a)) / a
     return _out(2.0 * sigma_c * a * a * _cohesive_bracket(S))
+
+
+def predictions(scene) -> dict:
+    """The closed forms beside a flat-punch pull, SI, keyed as in :mod:`pulloff.model.outputs`
+    (nan where a formula does not apply).
+
+    With the zone on the punch face (``cohesive_zone: internal``) the elastic MDR-Dugdale forces
+    are those of :func:`elastic_internal_onset` (``elastic_b`` is then the radius); the seed's
+    forms are for its external zone. A Maxwell solid's elastic forms are those of the relaxed
+    modulus, and beside them the instantaneous modulus's (a pull much faster than every tau).
+    """
+    nan = math.nan
+    spectrum = scene.material.spectrum()
+    G, eta = spectrum.G_inf, spectrum.eta
+    sigma_c, delta, gamma = scene.adhesion.sigma_c, scene.adhesion.delta, scene.adhesion.gamma
+    a, v = scene.geometry.radius, scene.loading.v
+    internal = scene.geometry.cohesive_zone == "internal"
+    out = dict.fromkeys(("seed_linearised_t_detach", "seed_linearised_F",
+                         "seed_closed_form_t_detach", "seed_closed_form_F"), nan)
+    out["seed_closed_form_branch"] = ""
+    if not internal:
+        lin = seed_linearised(G, eta, sigma_c, delta, a, v)
+        closed = seed_closed_form(G, eta, sigma_c, delta, a, v)
+        out.update(seed_linearised_t_detach=lin["t_detach"], seed_linearised_F=lin["F"],
+                   seed_closed_form_t_detach=closed["t_detach"], seed_closed_form_F=closed["F"],
+                   seed_closed_form_branch=closed["branch"])
+    out["kendall_F"] = kendall_force(G, gamma, a) if G > 0 else nan
+    out["viscous_F"] = viscous_force(eta, v, a)
+    out["elastic_F_contact"] = out["elastic_F_total"] = out["elastic_b"] = nan
+    if G > 0:
+        el = _elastic_onset(G, sigma_c, delta, a, internal)
+        out.update(elastic_F_contact=el["F_contact"], elastic_F_total=el["F_total"],
+                   elastic_b=a if internal else el["b"])
+    out["elastic_instant_F_contact"] = out["elastic_instant_F_total"] = nan
+    if spectrum.arms:
+        el = _elastic_onset(spectrum.instantaneous_modulus, sigma_c, delta, a, internal)
+        out.update(elastic_instant_F_contact=el["F_contact"], elastic_instant_F_total=el["F_total"])
+    return out
+
+
+def _elastic_onset(G, sigma_c, delta, a, internal):
+    return (elastic_internal_onset(G, sigma_c, delta, a) if internal
+            else elastic_mdr_dugdale(G, sigma_c, delta, a))

@@ -1,0 +1,128 @@
+"""Every output quantity, declared once: name, unit, meaning and which scenes have it.
+
+The :class:`pulloff.solvers.result.Result`, the HDF5 units, the sweep columns, the console table
+and the README's output list are all read from :data:`OUTPUTS`. A quantity a scene does not have
+is ``nan`` (or empty text) in its result, never missing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: Which scenes have a quantity (the ``where`` of :class:`Quantity`), as a user reads it.
+WHERE = {
+    "all": "every scene",
+    "pull": "scenes pulled at constant speed (loading.kind = constant_velocity)",
+    "separation": "scenes run to separation (model.until = separation) or with a receding "
+                  "contact edge (internal zone, compliant machine, Maxwell solids)",
+    "seed": "the flat punch with its zone outside (the seed's closed forms)",
+    "elastic_limit": "solids with a relaxed modulus G_inf > 0",
+    "maxwell": "standard linear solids and Prony series (the instantaneous modulus)",
+}
+
+
+@dataclass(frozen=True)
+class Quantity:
+    name: str
+    unit: str  # SI; "1" dimensionless, "" text or flag
+    meaning: str
+    group: str  # history | summary | analytic
+    where: str = "all"  # a key of WHERE
+    text: bool = False  # a string or flag, not a number
+
+
+def _q(group):
+    def make(name, unit, meaning, where="all", text=False):
+        return Quantity(name, unit, meaning, group, where, text)
+    return make
+
+
+_h, _s, _a = _q("history"), _q("summary"), _q("analytic")
+
+OUTPUTS = (
+    _h("t", "s", "time"),
+    _h("h", "m", "indenter lift (negative when pressed in); behind a spring it lags the driver"),
+    _h("a", "m", "contact (bond) radius"),
+    _h("b", "m", "end of the cohesive zone"),
+    _h("gap", "m", "gap between the surfaces at r = b"),
+    _h("F_contact", "N", "force on the contact (bonded) region, tension positive"),
+    _h("F_total", "N", "force of the whole line load: contact and cohesive zone"),
+
+    _s("detached", "", "whether the onset of detachment was reached", text=True),
+    _s("t_detach", "s", "onset of detachment: first time with gap(b) = delta"),
+    _s("h_detach", "m", "lift at the onset"),
+    _s("b_detach", "m", "cohesive-zone end at the onset"),
+    _s("zone_ratio_detach", "1", "(b - a)/a at the onset"),
+    _s("F_contact_detach", "N", "F_contact at the onset (the seed's pull-off force, eq. 48)"),
+    _s("F_total_detach", "N", "F_total at the onset"),
+    _s("t_separation", "s", "complete separation: the zone has vanished", "separation"),
+    _s("F_peak_contact", "N", "largest F_contact of the run", "separation"),
+    _s("F_peak_total", "N", "largest F_total of the run (the pull-off force)", "separation"),
+    _s("t_peak_contact", "s", "time of the largest F_contact", "separation"),
+    _s("t_peak_total", "s", "time of the largest F_total", "separation"),
+    _s("alpha", "1", "the seed's group pi delta sigma_c a G / (4 v^2 eta^2)", "pull"),
+    _s("chi", "1", "elastic zone size pi G delta / (sigma_c a)", "pull"),
+    _s("V", "1", "viscous against cohesive stress eta v / (sigma_c a)", "pull"),
+    _s("error_estimate", "1", "estimated relative error of the controlled outputs"),
+    _s("observed_order", "1", "order of the error in the step, measured from the last three "
+                              "levels (nan where they do not support one)"),
+    _s("n_elements", "1", "foundation elements of the reported run"),
+    _s("n_steps", "1", "time steps of the reported run"),
+    _s("wall_time", "s", "wall-clock time of the simulation"),
+    _s("t_end", "s", "last simulated time"),
+    _s("solver", "", "the solver that ran the scene", text=True),
+    _s("history", "", "model.history of the scene", text=True),
+    _s("until", "", "model.until of the scene", text=True),
+    _s("cohesive_zone", "", "geometry.cohesive_zone of a flat punch", text=True),
+    _s("notes", "", "what the user should know about this run, joined by '; '", text=True),
+
+    _a("seed_linearised_t_detach", "s", "root of the seed's eq. 53", "seed"),
+    _a("seed_linearised_F", "N", "eq. 48 at the eq. 53 root", "seed"),
+    _a("seed_closed_form_t_detach", "s", "the seed's closed-form t (eqs. 64/89)", "seed"),
+    _a("seed_closed_form_F", "N", "the seed's closed-form force", "seed"),
+    _a("seed_closed_form_branch", "", "which closed form applies (small or large alpha)", "seed",
+       text=True),
+    _a("kendall_F", "N", "Kendall's pull-off force sqrt(8 pi E* a^3 gamma) (eq. 95)",
+       "elastic_limit"),
+    _a("viscous_F", "N", "the viscous limit 8 eta v a (eq. 96)", "pull"),
+    _a("elastic_F_contact", "N", "elastic MDR-Dugdale F_contact with the relaxed modulus",
+       "elastic_limit"),
+    _a("elastic_F_total", "N", "elastic MDR-Dugdale F_total with the relaxed modulus",
+       "elastic_limit"),
+    _a("elastic_b", "m", "elastic MDR-Dugdale zone end with the relaxed modulus",
+       "elastic_limit"),
+    _a("elastic_instant_F_contact", "N", "elastic F_contact with the instantaneous modulus",
+       "maxwell"),
+    _a("elastic_instant_F_total", "N", "elastic F_total with the instantaneous modulus",
+       "maxwell"),
+)
+
+BY_NAME = {q.name: q for q in OUTPUTS}
+
+
+def of_group(group: str) -> tuple[Quantity, ...]:
+    return tuple(q for q in OUTPUTS if q.group == group)
+
+
+def units(group: str) -> dict[str, str]:
+    """``name -> unit`` of one group, in declaration order."""
+    return {q.name: q.unit for q in of_group(group)}
+
+
+def numeric(group: str) -> tuple[str, ...]:
+    return tuple(q.name for q in of_group(group) if not q.text)
+
+
+def markdown() -> str:
+    """The README's list of outputs, generated from the table (a test keeps them equal)."""
+    titles = {"history": "`history/` datasets (one time axis, `t` attached as their scale)",
+              "summary": "`summary` attributes (each with a `NAME__unit` companion)",
+              "analytic": "`analytic` attributes: closed forms beside the run"}
+    lines = []
+    for group, title in titles.items():
+        lines.append(f"- {title}:")
+        for q in of_group(group):
+            unit = f" [{q.unit}]" if q.unit not in ("", "1") else ""
+            where = "" if q.where == "all" else f" ({WHERE[q.where]}; nan otherwise)"
+            lines.append(f"  - `{q.name}`{unit}: {q.meaning}{where}")
+    return "\n".join(lines)

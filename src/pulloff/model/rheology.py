@@ -1,0 +1,129 @@
+"""Rheologies of the half-space: each maps element by element in MDR (MODEL.md section 6).
+
+A rheology is its shear relaxation modulus ``G(t) = G_inf + eta delta(t) + sum_i G_i
+exp(-t/tau_i)`` (:class:`Spectrum`). Every foundation element of width ``dx`` then obeys
+``q = 4 int G(t - s) du(s)`` (a line load per unit length). Two element laws cover every kind:
+Kelvin-Voigt (``eta``, no arms; elastic is ``eta = 0``) and the generalised Maxwell solid (arms,
+no ``eta``). Adding a rheology is one class here with a :data:`RHEOLOGIES` row; it need only
+say what its spectrum is.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from .fields import Num, bad_line
+from .registry import Kind, Registry
+
+RHEOLOGIES = Registry("material")
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """``G(t) = G_inf + eta delta(t) + sum G_i exp(-t/tau_i)``; SI (Pa, Pa s, s)."""
+
+    G_inf: float  # Pa, relaxed modulus
+    eta: float = 0.0  # Pa s, Kelvin-Voigt damper
+    arms: tuple = ()  # ((G_i [Pa], tau_i [s]), ...), Maxwell arms
+
+    @property
+    def instantaneous_modulus(self) -> float:
+        """``G(0+)`` [Pa]: what a step in displacement meets first (inf behind a damper)."""
+        if self.eta > 0.0:
+            return math.inf
+        return self.G_inf + sum(G for G, _ in self.arms)
+
+    @property
+    def law(self) -> str:
+        """The element law that integrates this spectrum: ``kelvin_voigt`` or ``maxwell``."""
+        return "maxwell" if self.arms else "kelvin_voigt"
+
+    @property
+    def relaxation_times(self) -> tuple:
+        """Every time scale of the spectrum [s] (``eta/G_inf`` for Kelvin-Voigt)."""
+        if self.arms:
+            return tuple(tau for _, tau in self.arms)
+        if self.eta > 0.0 and self.G_inf > 0.0:
+            return (self.eta / self.G_inf,)
+        return ()
+
+    def modulus(self, t):
+        """``G(t)`` [Pa] for ``t > 0`` (the damper's delta excluded)."""
+        import numpy as np
+
+        t = np.asarray(t, dtype=float)
+        return self.G_inf + sum(G * np.exp(-t / tau) for G, tau in self.arms)
+
+
+class Rheology(Kind):
+    """A half-space material (incompressible: ``E* = 4 G``)."""
+
+    def spectrum(self) -> Spectrum:
+        raise NotImplementedError
+
+
+@RHEOLOGIES.register
+class Elastic(Rheology):
+    """Linear elastic half-space."""
+
+    kind: Literal["elastic"] = Field(description="rheology: elastic")
+    G: Num = Field(gt=0, description="shear modulus, Pa")
+
+    def spectrum(self) -> Spectrum:
+        return Spectrum(self.G)
+
+
+@RHEOLOGIES.register
+class KelvinVoigt(Rheology):
+    """Spring ``G`` parallel to a damper ``eta`` (the seed's solid)."""
+
+    kind: Literal["kelvin_voigt"] = Field(description="rheology: kelvin_voigt")
+    G: Num = Field(ge=0, description="shear modulus, Pa")
+    eta: Num = Field(ge=0, description="shear viscosity, Pa s")
+
+    @model_validator(mode="after")
+    def _has_stiffness(self) -> KelvinVoigt:
+        if self.G == 0 and self.eta == 0:
+            raise bad_line("{p}G = 0.0, {p}eta = 0.0: both zero "
+                           "(need G > 0 or eta > 0; a half-space with neither has no stiffness)")
+        return self
+
+    def spectrum(self) -> Spectrum:
+        return Spectrum(self.G, self.eta)
+
+
+@RHEOLOGIES.register
+class StandardLinearSolid(Rheology):
+    """Relaxed spring ``G_inf`` parallel to one Maxwell arm (spring ``G_1``, time ``tau_1``)."""
+
+    kind: Literal["standard_linear_solid"] = Field(description="rheology: standard_linear_solid")
+    G_inf: Num = Field(gt=0, description="relaxed (long-time) shear modulus, Pa")
+    G_1: Num = Field(gt=0, description="shear modulus of the Maxwell arm, Pa")
+    tau_1: Num = Field(gt=0, description="relaxation time of the Maxwell arm, s")
+
+    def spectrum(self) -> Spectrum:
+        return Spectrum(self.G_inf, 0.0, ((self.G_1, self.tau_1),))
+
+
+class PronyTerm(Kind):
+    """One Maxwell arm of a Prony series: a spring G in series with a damper G tau."""
+
+    G: Num = Field(gt=0, description="shear modulus of the arm, Pa")
+    tau: Num = Field(gt=0, description="relaxation time of the arm, s")
+
+
+@RHEOLOGIES.register
+class Prony(Rheology):
+    """Generalised Maxwell solid: ``G_inf`` and any number of arms."""
+
+    kind: Literal["prony"] = Field(description="rheology: prony")
+    G_inf: Num = Field(gt=0, description="relaxed (long-time) shear modulus, Pa")
+    terms: list[PronyTerm] = Field(min_length=1,
+                                   description="Maxwell arms of the Prony series, list of {G, tau}")
+
+    def spectrum(self) -> Spectrum:
+        return Spectrum(self.G_inf, 0.0, tuple((term.G, term.tau) for term in self.terms))

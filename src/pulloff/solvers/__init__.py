@@ -1,0 +1,51 @@
+"""Solvers: which one runs a scene (one routing rule), and running it.
+
+Every solver declares what it does not support (:meth:`Solver.unsupported`); :func:`route` runs
+a scene with the first solver that supports every setting of it. A scene no solver supports is
+rejected before any work with the problems of the solver that came closest: the fewest problems
+with the model itself (geometry, material, adhesion, loading, model), then the fewest with
+settings (numerics, output); on a tie the more general one, later in :data:`SOLVERS`.
+"""
+
+from __future__ import annotations
+
+from ..model.scene import SceneError
+from .base import Solver
+from .edge import EdgeSolver
+from .frozen import FrozenSolver
+from .observers import Observers
+from .onset import OnsetSolver
+
+#: In order of preference: the specialised closed form and onset stepper before the general one.
+SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetSolver(), EdgeSolver())
+
+
+def route(scene) -> Solver:
+    """The solver that runs ``scene``; :class:`SceneError` naming every unsupported setting
+    otherwise."""
+    best, best_rank = None, None
+    for solver in SOLVERS:
+        problems = solver.unsupported(scene)
+        if not problems:
+            return solver
+        settings = sum(line.startswith(("numerics.", "output.")) for line in problems)
+        rank = (len(problems) - settings, settings)
+        if best_rank is None or rank <= best_rank:
+            best, best_rank = problems, rank
+    raise SceneError(best)
+
+
+def check(scene) -> None:
+    """Raise :class:`SceneError` unless a solver honours every setting of ``scene``."""
+    route(scene)
+
+
+def simulate(scene, progress=None, stream=None, observers: Observers | None = None):
+    """Run a validated scene; SI :class:`pulloff.solvers.result.Result`.
+
+    ``progress`` is a progress hook (see :class:`Observers`) and ``stream`` a callable taking
+    SI history columns as a fixed-step run computes them.
+    """
+    solver = route(scene)
+    observers = observers or Observers.for_scene(scene, progress=progress, stream=stream)
+    return solver.solve(scene, observers)

@@ -1,0 +1,46 @@
+"""What a solver is: the scenes it supports (and why not others), and how it runs one."""
+
+from __future__ import annotations
+
+from ..model.fields import fmt
+
+
+class Solver:
+    """A way to run scenes. ``unsupported(scene)`` lists, one line each, every setting of the
+    scene this solver would not honour (``key = value: reason``); a solver runs a scene only
+    when that list is empty, so no setting is ever silently ignored."""
+
+    name = ""
+    summary = ""
+
+    def unsupported(self, scene) -> list[str]:
+        raise NotImplementedError
+
+    def solve(self, scene, observers):
+        """Run ``scene`` with :class:`pulloff.solvers.observers.Observers`; returns a
+        :class:`pulloff.solvers.result.Result`."""
+        raise NotImplementedError
+
+
+def problem(key: str, value, reason: str) -> str:
+    """One problem line: the dotted key, the value as a user writes it, the reason."""
+    return f"{key} = {fmt(value)}: {reason}"
+
+
+def flat_punch_pull(scene, solver: str, zones=("external",), machine=False) -> list[str]:
+    """Problems of a scene for a solver that pulls a flat punch at constant speed."""
+    out = []
+    if scene.geometry.kind != "flat_punch":
+        out.append(problem("geometry.kind", scene.geometry.kind,
+                           f"the {solver} solver pulls a flat punch only"))
+    elif scene.geometry.cohesive_zone not in zones:
+        out.append(problem("geometry.cohesive_zone", scene.geometry.cohesive_zone,
+                           f"the {solver} solver puts the cohesive zone "
+                           f"{' or '.join(zones)} only"))
+    if scene.loading.kind != "constant_velocity":
+        out.append(problem("loading.kind", scene.loading.kind,
+                           f"the {solver} solver pulls at constant speed only"))
+    elif scene.loading.machine_stiffness is not None and not machine:
+        out.append(problem("loading.machine_stiffness", scene.loading.machine_stiffness,
+                           f"the {solver} solver assumes a rigid machine"))
+    return out

@@ -1,0 +1,108 @@
+"""The one accuracy controller: a ladder of runs, each with half the step of the one before,
+judged by a Richardson estimate from the last three.
+
+A solver supplies ``run(n)`` (one pass at resolution ``n``), ``outputs(run)`` (the numbers the
+estimate controls; nan where a run has none) and ``can_refine(run)``; the loop doubles ``n``
+until the estimate is below ``rtol / 2`` or no further level is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+#: Below this measured order the levels are not (yet) converging: no extrapolation.
+DIVERGING_ORDER = 0.5
+
+
+@dataclass(frozen=True)
+class Order:
+    """What a solver claims of its error: ``C dt^p`` with ``p`` measured, then clipped to
+    ``[low, high]`` (``high`` is the method's order, so a pre-asymptotic accident never shrinks
+    the estimate)."""
+
+    low: float = 1.0
+    high: float = 2.0
+
+
+def relative_spread(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest relative difference of two output vectors where both are finite (``inf`` if one
+    run found an event the other did not)."""
+    if not np.array_equal(np.isnan(a), np.isnan(b)):
+        return math.inf
+    mask = np.isfinite(a) & np.isfinite(b) & (b != 0)
+    if not np.any(mask):
+        return 0.0
+    return float(np.max(np.abs(a[mask] - b[mask]) / np.abs(b[mask])))
+
+
+def richardson(values: Sequence[np.ndarray], order: Order) -> tuple[float, float]:
+    """``(estimate, measured order)`` of the finest of three levels (step ratio 2).
+
+    For the output that changed most between the last two levels: its last difference divided
+    by ``2^p - 1``, ``p`` measured from the three levels and clipped to ``order``. Below a
+    measured order of 0.5 the levels are not converging and the estimate is the larger of the
+    last two differences, with no extrapolation. An event found on one level only gives
+    ``inf``.
+    """
+    v0, v1, v2 = (np.asarray(v, dtype=float) for v in values)
+    if not np.array_equal(np.isnan(v1), np.isnan(v2)):
+        return math.inf, math.nan
+    mask = np.isfinite(v2) & (v2 != 0) & np.isfinite(v1) & np.isfinite(v0)
+    if not np.any(mask):
+        return 0.0, math.nan
+    d_last = np.abs(v2 - v1)[mask] / np.abs(v2[mask])
+    d_prev = np.abs(v1 - v0)[mask] / np.abs(v2[mask])
+    worst = int(np.argmax(d_last))
+    if d_last[worst] == 0.0:
+        return 0.0, math.nan
+    measured = math.log2(d_prev[worst] / d_last[worst]) if d_prev[worst] > 0 else order.high
+    if measured < DIVERGING_ORDER:
+        return float(max(d_last[worst], d_prev[worst])), measured
+    p = min(order.high, max(order.low, measured))
+    return float(d_last[worst] / (2.0 ** p - 1.0)), measured
+
+
+@dataclass
+class Ladder:
+    """The outcome of :func:`refine`: every level run, the estimate of the finest, the order
+    measured from the last three (nan before three levels)."""
+
+    levels: list
+    estimate: float
+    order: float
+
+    @property
+    def finest(self):
+        return self.levels[-1]
+
+
+def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray], rtol: float,
+           n_first: int, order: Order, can_refine: Callable[[object, int], bool],
+           interrupted: Callable[[object], bool] = lambda r: False) -> Ladder:
+    """Run ``n_first, 2 n_first, ...`` until the estimate of the finest level is below
+    ``rtol / 2`` or ``can_refine(finest, next_n)`` says no.
+
+    With only two levels when refinement has to stop, the estimate is a third of their
+    difference (the second-order Richardson factor, without a measured order). A level that
+    reports ``interrupted`` ends the ladder at once with a nan estimate.
+    """
+    levels = []
+    n = n_first
+    estimate, measured = math.nan, math.nan
+    while True:
+        levels.append(run(n))
+        if interrupted(levels[-1]):
+            return Ladder(levels, math.nan, math.nan)
+        if len(levels) >= 3:
+            estimate, measured = richardson([outputs(r) for r in levels[-3:]], order)
+            if estimate <= 0.5 * rtol:
+                return Ladder(levels, estimate, measured)
+        if not can_refine(levels[-1], 2 * n):
+            if len(levels) == 2:
+                estimate = relative_spread(outputs(levels[0]), outputs(levels[1])) / 3.0
+            return Ladder(levels, estimate, measured)
+        n *= 2

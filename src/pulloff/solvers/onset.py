@@ -1,0 +1,559 @@
+"""The seed's onset stepper: the flat punch with its zone outside, pulled to the onset.
+
+The seed scene (MODEL.md section 3) in dimensionless form (see :mod:`.problem`): lengths along
+the foundation in units of ``a``, displacements, lift and gap in ``delta``, time in
+``T = delta / v``. Then
+
+    s(t) = sqrt(b^2 - 1) = k (h0 + t) + c,   k = 2 G delta / (sigma_c a),  c = 2 eta v / (sigma_c a)
+    k U + c dU/dt = sqrt(s^2 - sigma^2)  for an element at sigma = sqrt(x^2 - 1) < s(t)
+    gap = (2/pi) [ h atan(s) - int_1^b U / sqrt(b^2 - x^2) dx ]
+
+and detachment is the first ``gap = 1``. ``alpha = (pi/2) k / c^2``, ``chi = (pi/2) k``,
+``V = c / 2``. The numerical work lives in :mod:`pulloff.kernels.onset`; this module chooses the
+step from ``rtol``, checks it by step doubling (:mod:`.levels`), and converts back to SI.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..kernels import onset as kernels
+from ..model import analytic
+from . import levels as ladder
+from .base import Solver, flat_punch_pull, problem as problem_line
+from .frozen import frozen_detach_time, frozen_gap, zone_ratio
+from .observers import decimate, no_progress, stream_every
+from .problem import Problem, si_history
+from .result import Result
+
+#: Steps per reference time at ``rtol = 1``; the measured error constant of the stepper on the
+#: shipped scenes is ~1e-2 (relative error ~ 1e-2 / N^2), so this starts one doubling short.
+#: ``_MAX_STEPS`` caps the finest level (its cost grows like the square of the steps).
+_STEP_CONSTANT = 0.02
+_MIN_STEPS = 16
+_MAX_STEPS = 200_000
+#: The stepper is second order; pre-asymptotically it passes through lower observed orders
+#: where the relaxation layer ``c/k`` is about one step wide.
+ORDER = ladder.Order(1.0, 2.0)
+
+
+# --------------------------------------------------------------------------------------------
+# Time stepping of the foundation.
+
+@dataclass
+class FoundationRun:
+    """One time-stepped pass at a fixed step (all dimensionless)."""
+
+    dt: float
+    t: np.ndarray  # times of steps 0..n
+    gap: np.ndarray
+    t_detach: float  # nan if no crossing
+    n_elements: int
+    n_steps: int
+    snapshots: list = field(default_factory=list)  # (t, sigma, U)
+    interrupted: bool = False  # Ctrl-C arrived: the run holds what was computed until then
+    steps: np.ndarray | None = None  # step numbers of the recorded rows
+    n_thinned: int = 0  # times the element arrays were full and thinned
+
+
+def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
+    """Time where the gap reaches 1 inside step ``n`` (third-order local interpolation).
+
+    A quadratic through the last three points keeps the location error below the stepper's
+    second-order error; it falls back to linear when only two points exist.
+    """
+    t1, t2 = t[n - 1], t[n]
+    g1, g2 = gap[n - 1], gap[n]
+    t_lin = t1 + (1.0 - g1) * (t2 - t1) / (g2 - g1)
+    if n < 2:
+        return t_lin
+    t0, g0 = t[n - 2], gap[n - 2]
+    # Newton form of the quadratic through the three points, solved near the linear guess.
+    d1 = (g2 - g1) / (t2 - t1)
+    d2 = ((g2 - g1) / (t2 - t1) - (g1 - g0) / (t1 - t0)) / (t2 - t0)
+
+    def residual(tt):
+        return g2 + d1 * (tt - t2) + d2 * (tt - t2) * (tt - t1) - 1.0
+
+    if residual(t1) <= 0.0 <= residual(t2):
+        return brentq(residual, t1, t2, xtol=1e-300, rtol=1e-15)
+    return t_lin
+
+
+def preloaded_mesh(s0: float, n: int):
+    """Nodes ``sigma`` (ascending, from 0) of the zone loaded at ``t = 0`` and ``s0 - sigma``.
+
+    Uniform in angle, ``sigma = s0 cos(theta)``: they cluster toward ``b(0)``, where the load
+    of an element is weakest and varies fastest. The offsets ``s0 - sigma`` are exact, so the
+    kernels never subtract two nearly equal ``s`` and ``sigma``. No nodes when ``s0 = 0``.
+    """
+    if s0 <= 0.0:
+        return np.zeros(0), np.zeros(0)
+    angles = np.arange(n, 0, -1) * (0.5 * np.pi / n)
+    sigma = s0 * np.cos(angles)
+    sigma[0] = 0.0
+    return sigma, 2.0 * s0 * np.sin(0.5 * angles) ** 2
+
+
+#: Ages with tabulated weights, so the tables stay small however long the run. Older elements
+#: use :func:`pulloff.kernels.onset_weight_pair`'s expansion (equal to the tables to rounding)
+#: and, in the gap, the trapezoid on ``v`` (accurate: ``U/q`` has long relaxed). rtol runs
+#: never reach this age.
+_TABLE_AGES = 1 << 16
+#: Rows of one ``march`` call's history buffer: the history in memory never grows with the run
+#: beyond what is recorded.
+_CHUNK_STEPS = 1 << 16
+_MIN_CHUNK = 2048
+
+
+def step_weights(k: float, c: float, dt: float, n_ages: int):
+    """All weights of one step size, in the order :func:`pulloff.kernels.march` takes them:
+    ``(decay, w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new,
+    ratio, w_young, w_old)``, tabulated for element ages up to ``min(n_ages, _TABLE_AGES)``
+    steps (tables of zeros when ``k = 0``: no element ever enters)."""
+    n_tab = max(kernels.ONSET_ASYMPTOTIC_AGE, min(n_ages, _TABLE_AGES))
+    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
+    rule = (kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
+    if k > 0.0:
+        w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_tab, *rule)
+        scale, m_old, m_new = kernels.onset_moments(k, c, dt, *rule)
+        ratio, w_young, w_old = kernels.age_interval_weights(
+            k, c, dt, n_tab, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
+            kernels.TS_FINE_WEIGHTS)
+    else:
+        w_on_old = w_on_new = np.zeros(n_tab)
+        scale, m_old, m_new = 0.0, np.zeros(kernels.BINOM_HALF.size), np.zeros(
+            kernels.BINOM_HALF.size)
+        ratio = np.zeros(n_tab + 1)
+        w_young = w_old = np.zeros(n_tab)
+    return (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio,
+            w_young, w_old)
+
+
+class _History:
+    """Rows of one run kept as they arrive: every ``every``-th step in memory, and every
+    ``stream_every``-th step handed to ``stream`` (SI columns, see :func:`si_history`), so
+    neither memory nor the kernel's buffer grows with the number of steps."""
+
+    def __init__(self, problem, every, stream=None, stream_every=1):
+        self.problem = problem
+        self.every = max(1, int(every))
+        self.stream = stream
+        self.stream_every = max(1, int(stream_every))
+        self.steps, self.gaps = [], []
+        self.tail = np.zeros((0, 2))  # the last three raw rows (time, gap): event location
+
+    def add(self, steps: np.ndarray, t: np.ndarray, gap: np.ndarray) -> None:
+        if self.every == 1:
+            self.steps.append(steps)
+            self.gaps.append(gap)
+        else:
+            keep = steps % self.every == 0
+            self.steps.append(steps[keep])
+            self.gaps.append(gap[keep])
+        if self.stream is not None:
+            # The crossing row lies past the event; the caller appends the event itself.
+            send = (steps % self.stream_every == 0) & (gap < 1.0)
+            if np.any(send):
+                self.stream(si_history(self.problem, t[send], gap[send]))
+        if t.size >= 3:
+            self.tail = np.column_stack([t[-3:], gap[-3:]])
+        else:
+            self.tail = np.concatenate([self.tail, np.column_stack([t, gap])])[-3:]
+
+    def arrays(self, dt, last_step):
+        steps = np.concatenate(self.steps) if self.steps else np.zeros(0, dtype=np.int64)
+        gaps = np.concatenate(self.gaps) if self.gaps else np.zeros(0)
+        if steps.size == 0 or steps[-1] != last_step:
+            # The run's last row always belongs to the history, recorded or not.
+            steps = np.append(steps, last_step)
+            gaps = np.append(gaps, self.tail[-1, 1])
+        return steps, steps * dt, gaps
+
+
+def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
+                   progress=None, n_preloaded: int | None = None, record_every: int = 1,
+                   max_elements: int | None = None, stream=None,
+                   stream_every: int = 1) -> FoundationRun:
+    """Step the foundation with step ``dt`` until detachment or ``n_stop`` steps.
+
+    Elements entering the zone are placed at ``b`` after every step, so their spacing is set by
+    the step; ``n_preloaded`` (default: matched to that spacing) sets the mesh of the part of
+    the zone that is loaded from ``t = 0``. With ``max_elements`` the entered elements live in
+    arrays of that size: when they are full the old ones are thinned to a geometric grading
+    in age (:func:`pulloff.kernels.thin_entered`), so a run of any length keeps O(max_elements)
+    state. The history keeps every ``record_every``-th step in memory and hands every
+    ``stream_every``-th to ``stream`` (a callable taking :func:`si_history` columns).
+    """
+    k, c, h0 = problem.k, problem.c, problem.h0_scaled
+    s0 = problem.s_of(0.0)
+    # Elements already inside the zone at t = 0: as many as entering elements would fill the
+    # same range of sigma.
+    s_ref = problem.s_of(n_stop * dt)
+    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
+    if max_elements is not None:
+        # A budget bounds this part too (a quarter of it): its mesh then stops refining with
+        # the step.
+        n_pre = min(n_pre, max(8, int(max_elements) // 4))
+    sig_pre, offset_pre = preloaded_mesh(s0, n_pre)
+    if c == 0.0:
+        # An elastic element follows its load at once, also the step lift h0 at t = 0.
+        U_pre = np.sqrt(offset_pre * (s0 + sig_pre)) / k
+    else:
+        U_pre = np.zeros_like(sig_pre)  # a damper cannot move instantly (MODEL.md: u(x,0) = 0)
+    capacity = n_stop + 2
+    if max_elements is not None:
+        capacity = min(capacity, max(16, int(max_elements) - sig_pre.size))
+    born = np.zeros(capacity, dtype=np.int64)
+    sig_born = np.zeros(capacity)
+    U_born = np.zeros(capacity)
+    dx_born = np.zeros(capacity)
+    # Quadrature weights of thinned intervals (only ever written by thinning).
+    thin_w = np.zeros((capacity if max_elements is not None else 1, 4))
+    sig_born[0] = s0
+    nodes_pre = np.append(sig_pre, s0)
+    x_pre = np.sqrt(1.0 + nodes_pre * nodes_pre)
+    # kernels.interval_width, vectorised: x widths without cancellation for thin zones.
+    dx_pre = np.zeros(nodes_pre.size)
+    dx_pre[1:] = (np.diff(nodes_pre) * (nodes_pre[1:] + nodes_pre[:-1])
+                  / (x_pre[1:] + x_pre[:-1]))
+    # With a budget the preloaded mesh stops refining with the step: the cubic on v keeps
+    # its error far below the trapezoid's (fourth order in its spacing).
+    pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
+             and sig_pre.size >= 3 else np.zeros((1, 4)))
+    n_born = 1
+    weights = step_weights(k, c, dt, n_stop + 2)
+    history = _History(problem, record_every, stream, stream_every)
+    gap0 = float(frozen_gap(problem, 0.0))  # the frozen and exact states agree at t = 0
+    history.add(np.zeros(1, dtype=np.int64), np.zeros(1), np.array([gap0]))
+    if gap0 >= 1.0:
+        return FoundationRun(dt, np.zeros(1), np.array([gap0]), 0.0, sig_pre.size + n_born, 0,
+                             steps=np.zeros(1, dtype=np.int64))
+
+    # Stops for snapshots and progress; the kernel runs uninterrupted between them. A snapshot
+    # between two steps interpolates the states at both ends (second order, like the stepper).
+    wanted = {}
+    for ts in snapshot_times:
+        n0 = min(n_stop, max(0, int(math.floor(ts / dt))))
+        wanted[ts] = (n0, min(n_stop, n0 + 1))
+    capture_steps = {n for pair in wanted.values() for n in pair}
+    captured = {}
+    if 0 in capture_steps:
+        captured[0] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
+    # ~50 stops for progress and Ctrl-C (a signal is seen when the kernel returns; the rows
+    # of that call are lost); at least _MIN_CHUNK steps each, so small runs pay no overhead.
+    chunk = max(_MIN_CHUNK, n_stop // 50)
+    stops = sorted((set(range(chunk, n_stop, chunk)) | capture_steps | {n_stop}) - {0})
+    buffer = min(n_stop, _CHUNK_STEPS)
+    t_buf = np.zeros(buffer + 1)
+    gap_buf = np.zeros(buffer + 1)
+    step = 0
+    crossed = False
+    interrupted = False
+    n_thinned = 0
+    j_consecutive = 0
+    try:
+        for stop in stops:
+            while step < stop:
+                row0 = step
+                step_new, n_born, code = kernels.march(
+                    sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
+                    dx_born, thin_w, n_born, j_consecutive, step, min(stop, row0 + buffer), k,
+                    c, h0, dt, *weights, t_buf, gap_buf, row0)
+                rows = step_new - row0
+                history.add(np.arange(row0 + 1, step_new + 1), t_buf[1:rows + 1].copy(),
+                            gap_buf[1:rows + 1].copy())
+                step = step_new
+                if progress is not None:
+                    progress(rows)
+                if code == kernels.MARCH_CROSSED:
+                    crossed = True
+                    break
+                if code == kernels.MARCH_FULL:
+                    n_born = _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step)
+                    # The young elements thinning keeps are the consecutive tail.
+                    gaps = np.nonzero(np.diff(born[:n_born]) > 1)[0]
+                    j_consecutive = int(gaps[-1]) + 1 if gaps.size else 0
+                    n_thinned += 1
+            if step in capture_steps:
+                captured[step] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
+            if crossed:
+                break
+    except KeyboardInterrupt:
+        # Compiled code does not see signals; Python raises on return, before ``step`` is
+        # updated, so the arrays and the history hold a consistent state up to ``step``.
+        interrupted = True
+    t_detach = math.nan
+    if crossed:
+        tail = history.tail
+        t_detach = _crossing_time(tail[:, 0], tail[:, 1], tail.shape[0] - 1)
+    t_end = t_detach if crossed else step * dt
+    snapshots = []
+    for ts in sorted(wanted):
+        n0, n1 = wanted[ts]
+        # Only times the run reached: none after detachment or past t_max.
+        if ts <= t_end and n0 in captured and n1 in captured:
+            snapshots.append((ts, *_interpolate_field(problem, captured[n0], captured[n1],
+                                                      ts / dt - n0, ts)))
+    steps, t, gap = history.arrays(dt, step)
+    return FoundationRun(dt, t, gap, t_detach, sig_pre.size + n_born, step, snapshots,
+                         interrupted, steps=steps, n_thinned=n_thinned)
+
+
+def _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step) -> int:
+    """Thin full element arrays to at most half their size (see ``kernels.thin_entered``)."""
+    capacity = sig_born.size
+    keep_young = capacity // 4
+    # A geometric grading from keep_young to the oldest age in capacity/4 elements.
+    oldest = max(step - born[0], keep_young + 1)
+    ratio_max = math.exp(math.log(oldest / keep_young) / (capacity // 4))
+    n_kept = kernels.thin_entered(born, sig_born, U_born, dx_born, thin_w, n_born, step,
+                                  keep_young, ratio_max)
+    if n_kept > capacity // 2 + capacity // 4:
+        raise RuntimeError(f"thinning kept {n_kept} of {capacity} elements")  # a bug, not input
+    return n_kept
+
+
+def _interpolate_field(problem, field0, field1, weight, t):
+    """Field at a time ``weight`` of the way from one step to the next (the newer element,
+    placed at the end of the step, is replaced by one at ``b(t)``)."""
+    sig0, U0 = field0
+    sig1, U1 = field1
+    if weight <= 0.0:
+        return sig0.copy(), U0.copy()
+    n = sig0.size
+    if sig1.size >= n and np.array_equal(sig1[:n], sig0):
+        U1_at_0 = U1[:n]
+    else:
+        # Old elements were thinned in between: the newer field, interpolated to the older nodes.
+        U1_at_0 = np.interp(sig0, sig1, U1)
+    U = (1.0 - weight) * U0 + weight * U1_at_0
+    s_t = problem.s_of(t)
+    if s_t > sig0[-1]:
+        return np.append(sig0, s_t), np.append(U, 0.0)
+    return sig0.copy(), U
+
+
+def _field(sig_pre, U_pre, sig_born, U_born, n_born):
+    return (np.concatenate([sig_pre, sig_born[:n_born]]),
+            np.concatenate([U_pre, U_born[:n_born]]))
+
+
+# --------------------------------------------------------------------------------------------
+# Accuracy control and the SI result.
+
+class OnsetSolver(Solver):
+    """The seed scene to its onset: a flat punch with its zone outside, a Kelvin-Voigt (or
+    elastic) solid, a rigid machine pulling at constant speed; exact load history."""
+
+    name = "onset"
+    summary = "seed onset stepper (flat punch, external zone, Kelvin-Voigt, rigid pull)"
+
+    def unsupported(self, scene) -> list[str]:
+        out = flat_punch_pull(scene, "onset")
+        if scene.material.kind not in ("kelvin_voigt", "elastic"):
+            out.append(problem_line("material.kind", scene.material.kind,
+                                    "the onset solver steps Kelvin-Voigt and elastic solids"))
+        if scene.model.history != "exact":
+            out.append(problem_line("model.history", scene.model.history,
+                                    "the onset solver steps the exact load history"))
+        if scene.model.until != "detach":
+            out.append(problem_line("model.until", scene.model.until,
+                                    "the onset solver stops at the onset of detachment"))
+        return out
+
+    def solve(self, scene, observers) -> Result:
+        wall_start = time.perf_counter()
+        problem = Problem.from_scene(scene)
+        T = problem.time_scale
+        t_limit = math.inf if scene.numerics.t_max is None else scene.numerics.t_max / T
+        t_frozen = frozen_detach_time(problem, t_limit)
+        notes = []
+        if scene.numerics.steps is not None:
+            run, estimate = _fixed_run(problem, t_frozen, t_limit, scene.numerics, observers)
+            if not estimate <= scene.numerics.rtol and not run.interrupted and run.t.size > 1:
+                notes.append(f"error estimate {estimate:.2g} above rtol "
+                             f"{scene.numerics.rtol:g} at the fixed {scene.numerics.steps} steps")
+            order = math.nan
+        else:
+            run, estimate, order = _exact_run(problem, t_frozen, t_limit, scene.numerics.rtol,
+                                              observers)
+            if not estimate <= scene.numerics.rtol and run.t.size > 1 and not run.interrupted:
+                notes.append(f"not converged: error estimate {estimate:.2g} above rtol "
+                             f"{scene.numerics.rtol:g} at the step cap ({_MAX_STEPS} steps)")
+        if run.n_thinned:
+            notes.append(f"element arrays thinned {run.n_thinned} times (numerics.max_elements)")
+        t_reached = run.t_detach if not math.isnan(run.t_detach) else run.t[-1]
+        notes += observers.skipped_snapshots(t_reached * T)
+        streamed = observers.stream is not None and scene.numerics.steps is not None
+        if streamed:
+            _end_stream(problem, run, observers, scene.numerics.steps)
+        return _assemble(scene, problem, run, estimate, order, observers,
+                         time.perf_counter() - wall_start, notes, streamed)
+
+
+def _end_stream(problem, run, observers, steps):
+    """The stream ends exactly at the event, or at the last step reached."""
+    if not math.isnan(run.t_detach):
+        observers.stream(si_history(problem, np.array([run.t_detach]), np.array([1.0])))
+    elif run.steps[-1] % stream_every(observers.every, steps, observers.history_rows) != 0:
+        observers.stream(si_history(problem, run.t[-1:], run.gap[-1:]))
+
+
+def _n_steps_for(rtol: float) -> int:
+    return int(min(_MAX_STEPS, max(_MIN_STEPS, math.ceil(math.sqrt(_STEP_CONSTANT / rtol)))))
+
+
+def _detach_outputs(problem: Problem, t: float):
+    return np.array([t, problem.contact_force(t), problem.total_force(t)], dtype=float)
+
+
+def _outputs(problem: Problem, run: FoundationRun) -> np.ndarray:
+    """What the ladder controls: time and forces at the onset, or the gap at the end of a run
+    that does not detach (all levels end at the same time then)."""
+    if math.isnan(run.t_detach):
+        return np.array([math.nan, math.nan, math.nan, run.gap[-1]])
+    return np.append(_detach_outputs(problem, run.t_detach), math.nan)
+
+
+#: Steps of the fixed-step mode's default element arrays (``numerics.max_elements``).
+_FIXED_MAX_ELEMENTS = 4096
+
+
+def _pull_time(problem, t_frozen, t_limit):
+    """Time span for a fixed step count: the detachment time of a cheap pilot run (64 steps
+    over the frozen bound, which bounds it from above) with a small margin, or ``t_max``."""
+    t_ref = min(t_frozen, t_limit)
+    if t_ref == 0.0 or not math.isfinite(t_ref):
+        return t_ref
+    pilot = run_foundation(problem, t_ref / 64, 68)
+    if math.isfinite(pilot.t_detach) and pilot.t_detach > 0:
+        # The pilot's error is ~1e-2/64^2: 2 % keeps the event inside the span.
+        t_ref = min(t_ref, 1.02 * pilot.t_detach)
+    return t_ref
+
+
+def _fixed_run(problem, t_frozen, t_limit, numerics, observers):
+    """``numerics.steps`` over the pull, checked by a run with half the steps and
+    ``1/sqrt(2)`` of the element budget. The step error is second order, the budget's
+    (thinned and fixed meshes, fourth-order quadrature) grows 2.8-5.7 times as the budget
+    shrinks by ``sqrt(2)`` (measured orders 3-5 in the budget); so a third of the difference
+    is within a factor 1/3..2 of the finer run's error whichever dominates."""
+    n = numerics.steps
+    max_elements = numerics.max_elements or _FIXED_MAX_ELEMENTS
+    t_ref = _pull_time(problem, t_frozen, t_limit)
+    if t_ref == 0.0:
+        return run_foundation(problem, 1.0, 0), 0.0
+
+    preview = max(1, math.ceil(_steps_to_cover(n, t_ref, t_limit) / observers.history_rows))
+    every = stream_every(observers.every, n, observers.history_rows)
+    runs = []
+    # The streamed run first: a Ctrl-C during the check leaves its whole history in the file.
+    for m, budget, sink in ((n, max_elements, observers.stream),
+                            (n // 2, max(64, int(max_elements / math.sqrt(2.0))), None)):
+        total = _steps_to_cover(m, t_ref, t_limit)
+        first = not runs
+        with observers.progress(f"{m} steps", total) as update:
+            runs.append(run_foundation(
+                problem, t_ref / m, total, [ts / problem.time_scale for ts in observers.snapshot_times] if first else (),
+                progress=update, record_every=preview, max_elements=budget, stream=sink,
+                stream_every=every))
+        if runs[-1].interrupted:
+            return dataclasses.replace(runs[0], interrupted=True), math.nan
+    full, half = runs
+    if math.isnan(half.t_detach) or math.isnan(full.t_detach):
+        return full, _gap_difference(half, full)
+    if full.t_detach == 0.0:
+        return full, 0.0
+    values = [_detach_outputs(problem, r.t_detach) for r in runs]
+    return full, float(np.max(np.abs(values[0] - values[1]) / np.abs(values[0])) / 3.0)
+
+
+def _steps_to_cover(n: int, t_ref: float, t_limit: float) -> int:
+    """Steps for ``n`` steps per ``t_ref``: the frozen time bounds detachment from above, but
+    rounding can put the crossing a hair beyond it, and a few spare steps are cheap. A user's
+    ``t_max`` is a hard end."""
+    return n if t_ref >= t_limit else n + max(2, n // 16)
+
+
+def _exact_run(problem, t_frozen, t_limit, rtol, observers):
+    """The ladder of step-doubled runs (:func:`pulloff.solvers.levels.refine`); returns the
+    finest run, its estimate and the measured order."""
+    t_ref = min(t_frozen, t_limit)
+    if t_ref == 0.0:
+        return run_foundation(problem, 1.0, 0), 0.0, math.nan
+    snapshots = [ts / problem.time_scale for ts in observers.snapshot_times]
+    n_first = max(_MIN_STEPS // 2, _n_steps_for(rtol) // 2)
+
+    def level(n, t_ref):
+        # In memory: every user-chosen step, or a power of two that keeps ~2000-4000 rows and
+        # lands the rows of consecutive levels on common times.
+        record = observers.every if observers.every is not None else max(1, n // 2048)
+        total = _steps_to_cover(n, t_ref, t_limit)
+        show = observers.progress if n > n_first else no_progress
+        with show(f"{n} steps", total) as update:
+            return run_foundation(problem, t_ref / n, total, snapshots if n > n_first else (),
+                                  progress=update, record_every=record)
+
+    coarse = level(n_first, t_ref)
+    # The exact model can detach well before the frozen bound; re-centre the grid on the
+    # coarse crossing so that the step count measures the pull that actually happens.
+    if coarse.n_steps < n_first // 2 and math.isfinite(coarse.t_detach) and coarse.t_detach > 0:
+        t_ref = min(t_ref, 1.25 * coarse.t_detach * (1.0 + 2.0 / n_first))
+        coarse = level(n_first, t_ref)
+    ladder_result = ladder.refine(
+        lambda n: coarse if n == n_first else level(n, t_ref),
+        lambda run: _outputs(problem, run), rtol, n_first, ORDER,
+        can_refine=lambda run, n: n <= _MAX_STEPS, interrupted=lambda run: run.interrupted)
+    return ladder_result.finest, ladder_result.estimate, ladder_result.order
+
+
+def _gap_difference(coarse: FoundationRun, fine: FoundationRun) -> float:
+    """A third of the largest gap difference of two runs (step ratio 2) at their common
+    recorded times, relative to the largest gap: the estimate when neither detaches."""
+    _, i_c, i_f = np.intersect1d(2 * coarse.steps, fine.steps, return_indices=True)
+    if i_c.size < 2:
+        return 0.0
+    g_c = coarse.gap[i_c]
+    g_f = fine.gap[i_f]
+    return float(np.max(np.abs(g_f - g_c)) / max(np.max(np.abs(g_f)), 1e-300)) / 3.0
+
+
+def _assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order: float,
+              observers, wall: float, notes: list, streamed: bool) -> Result:
+    T = problem.time_scale
+    detached = not math.isnan(run.t_detach)
+    t_hist, gap_hist = run.t, run.gap
+    if detached and run.t_detach > 0.0:
+        # Keep the rows before detachment and end the history exactly at the event.
+        keep = t_hist < run.t_detach
+        t_hist = np.append(t_hist[keep], run.t_detach)
+        gap_hist = np.append(gap_hist[keep], 1.0)
+    if observers.every is None or streamed:
+        # (A fixed-step run's full history is streamed; this is its preview.)
+        rows = decimate(t_hist.size, observers.history_rows)
+        t_hist, gap_hist = t_hist[rows], gap_hist[rows]
+    td = run.t_detach
+    summary = {"detached": detached, "error_estimate": float(estimate),
+               "observed_order": float(order), "n_elements": int(run.n_elements),
+               "n_steps": int(run.n_steps), "wall_time": wall, "t_end": float(t_hist[-1] * T),
+               "solver": "onset", "history": scene.model.history, "until": scene.model.until,
+               "cohesive_zone": scene.geometry.cohesive_zone, **problem.groups}
+    if detached:
+        summary.update(
+            t_detach=td * T, h_detach=float(problem.lift(td)),
+            b_detach=float(problem.zone_end(td)),
+            zone_ratio_detach=float(zone_ratio(problem.s_of(td))),
+            F_contact_detach=float(problem.contact_force(td)),
+            F_total_detach=float(problem.total_force(td)))
+    snapshots = [(ts * T, problem.a * np.sqrt(1.0 + sig * sig), problem.delta * U)
+                 for ts, sig, U in run.snapshots]
+    return Result.build(summary, analytic.predictions(scene), si_history(problem, t_hist, gap_hist),
+                        snapshots=snapshots, notes=notes, complete=not run.interrupted,
+                        history_streamed=streamed, problem=problem)
