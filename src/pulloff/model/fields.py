@@ -22,7 +22,8 @@ def bad(reason: str) -> PydanticCustomError:
 
 
 def bad_line(line: str) -> PydanticCustomError:
-    """A whole problem line for a section-level check; "{p}" stands for the section's prefix."""
+    """A whole problem line for a section-level check; "{p}" stands for the section's prefix
+    (with its dot: ``{p}G`` reads ``material.G``) and "{k}" for the section's own key."""
     return PydanticCustomError("scene", "{line}", {"line": line})
 
 

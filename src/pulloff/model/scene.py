@@ -192,7 +192,7 @@ def _problem(err: dict, data: Mapping) -> str:
     value = err.get("input") if (written := _given(data, loc)) is _NOTHING else written
     hint = f" ({info.description})" if info is not None and info.description else ""
     if typ == "scene" and "line" in ctx:
-        return ctx["line"].replace("{p}", f"{key}.")
+        return ctx["line"].replace("{p}", f"{key}.").replace("{k}", key)
     if typ == "missing":
         return f"{key}: missing{hint}"
     if typ in ("union_tag_invalid", "union_tag_not_found"):

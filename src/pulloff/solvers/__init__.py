@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from ..model.scene import SceneError
 from .base import Solver
-from .edge import EdgeSolver
+from .contact import ContactSolver
 from .frozen import FrozenSolver
 from .observers import Observers
 from .onset import OnsetSolver
 
 #: In order of preference: the specialised closed form and onset stepper before the general one.
-SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetSolver(), EdgeSolver())
+SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetSolver(), ContactSolver())
 
 
 def route(scene) -> Solver:

@@ -66,14 +66,38 @@ def richardson(values: Sequence[np.ndarray], order: Order) -> tuple[float, float
     return float(d_last[worst] / (2.0 ** p - 1.0)), measured
 
 
+def extrapolate(values: Sequence[np.ndarray], order: Order) -> tuple[np.ndarray, float]:
+    """Richardson-extrapolated outputs of the finest of three levels, and an estimate of their
+    relative error: the change between the extrapolations from the last two pairs of levels,
+    divided by ``2^p - 1`` (so it assumes the next term of the error is no faster than the
+    first). ``p`` is the order :func:`richardson` measures, clipped to ``order``; below the
+    diverging order no extrapolation is made (the finest values and an infinite estimate)."""
+    v0, v1, v2 = (np.asarray(v, dtype=float) for v in values)
+    _, measured = richardson(values, order)
+    if not math.isfinite(measured) or measured < DIVERGING_ORDER:
+        # No measured order (outputs unchanged between levels) or no convergence.
+        same = np.array_equal(v1, v2, equal_nan=True)
+        return v2.copy(), (0.0 if same else math.inf)
+    p = min(order.high, max(order.low, measured))
+    f = 1.0 / (2.0 ** p - 1.0)
+    e1 = v1 + (v1 - v0) * f
+    e2 = v2 + (v2 - v1) * f
+    mask = np.isfinite(e2) & np.isfinite(e1) & (e2 != 0)
+    if not np.any(mask):
+        return e2, 0.0
+    return e2, float(np.max(np.abs(e2 - e1)[mask] / np.abs(e2[mask])) * f)
+
+
 @dataclass
 class Ladder:
-    """The outcome of :func:`refine`: every level run, the estimate of the finest, the order
-    measured from the last three (nan before three levels)."""
+    """The outcome of :func:`refine`: every level run, the estimate of what is reported, the
+    order measured from the last three (nan before three levels), and the extrapolated outputs
+    (None unless asked for and three levels exist)."""
 
     levels: list
     estimate: float
     order: float
+    extrapolated: np.ndarray | None = None
 
     @property
     def finest(self):
@@ -82,9 +106,12 @@ class Ladder:
 
 def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray], rtol: float,
            n_first: int, order: Order, can_refine: Callable[[object, int], bool],
-           interrupted: Callable[[object], bool] = lambda r: False) -> Ladder:
-    """Run ``n_first, 2 n_first, ...`` until the estimate of the finest level is below
-    ``rtol / 2`` or ``can_refine(finest, next_n)`` says no.
+           interrupted: Callable[[object], bool] = lambda r: False,
+           extrapolated: bool = False) -> Ladder:
+    """Run ``n_first, 2 n_first, ...`` until the estimate is below ``rtol / 2`` or
+    ``can_refine(finest, next_n)`` says no. The estimate is that of the finest level
+    (:func:`richardson`), or with ``extrapolated`` that of the extrapolated outputs
+    (:func:`extrapolate`), which are then what the ladder reports.
 
     With only two levels when refinement has to stop, the estimate is a third of their
     difference (the second-order Richardson factor, without a measured order). A level that
@@ -92,17 +119,20 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
     """
     levels = []
     n = n_first
-    estimate, measured = math.nan, math.nan
+    estimate, measured, values = math.nan, math.nan, None
     while True:
         levels.append(run(n))
         if interrupted(levels[-1]):
             return Ladder(levels, math.nan, math.nan)
         if len(levels) >= 3:
-            estimate, measured = richardson([outputs(r) for r in levels[-3:]], order)
+            last = [outputs(r) for r in levels[-3:]]
+            estimate, measured = richardson(last, order)
+            if extrapolated:
+                values, estimate = extrapolate(last, order)
             if estimate <= 0.5 * rtol:
-                return Ladder(levels, estimate, measured)
+                return Ladder(levels, estimate, measured, values)
         if not can_refine(levels[-1], 2 * n):
             if len(levels) == 2:
                 estimate = relative_spread(outputs(levels[0]), outputs(levels[1])) / 3.0
-            return Ladder(levels, estimate, measured)
+            return Ladder(levels, estimate, measured, values)
         n *= 2

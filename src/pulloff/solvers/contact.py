@@ -1,0 +1,202 @@
+"""The contact solver: any indenter, rheology and loading the model knows, with the contact edge
+and the zone end free to move (MODEL.md sections 3, 6 and 9).
+
+The stepping is :class:`pulloff.solvers.contact_stepper.Stepper`; this module runs it on the
+ladder of :mod:`.levels` (each level halves every step), reports the extrapolated summary
+with its estimate, and converts to SI.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ..model import analytic
+from . import levels as ladder
+from .base import Solver, problem as problem_line
+from .contact_setup import FLAT_EXTERNAL, setup as make_setup
+from .contact_stepper import MAX_STEPS, Stepper
+from .frozen import frozen_detach_time
+from .problem import Problem
+from .result import Result
+
+#: Second order in the step (the paths of the edges are quadratic over a step, every element's
+#: load integral is exact for them); a higher measured order is not relied on.
+ORDER = ladder.Order(1.0, 2.0)
+#: A pull's end when the scene gives no t_max, in frozen onset times.
+DEFAULT_SPAN = 100.0
+_FIRST_N = 16
+
+#: What a level is judged by (summary names; nan where a run has none). The times of the peak
+#: forces are not among them: the time of a smooth maximum is ill-conditioned (an error
+#: ``e`` in the force moves it by ``sqrt(e)``), so they are reported uncontrolled.
+CONTROLLED = ("t_detach", "F_total_detach", "F_contact_detach", "t_separation",
+              "F_peak_total", "F_peak_contact")
+
+
+class ContactSolver(Solver):
+    """Flat punches (the zone outside or on the face) pulled to separation, and any
+    rheology, behind a rigid machine or a spring."""
+
+    name = "contact"
+    summary = "moving contact edge and zone end: separation, finite punch, any rheology, machine"
+
+    def unsupported(self, scene) -> list[str]:
+        out = []
+        if scene.geometry.kind != "flat_punch" and scene.loading.kind == "constant_velocity":
+            out.append(problem_line("loading.kind", scene.loading.kind, "a smooth indenter "
+                                    "starts apart: give a loading path (kind: path)"))
+        if scene.model.history != "exact":
+            out.append(problem_line(
+                "model.history", scene.model.history, "the seed's frozen load history (eq. 31) "
+                "is a Kelvin-Voigt onset closed form; the contact solver steps the exact "
+                "history" + (f" of a {scene.material.kind}" if scene.material.kind not in
+                             ("kelvin_voigt", "elastic") else "")))
+        if scene.numerics.steps is not None:
+            out.append(problem_line(
+                "numerics.steps", scene.numerics.steps, "fixed-step runs cover the seed's onset "
+                "only; a moving contact edge is refined from numerics.rtol"))
+        if scene.output.snapshots:
+            out.append(problem_line(
+                "output.snapshots", list(scene.output.snapshots), "the contact solver stores "
+                "no displacement profiles yet"))
+        if scene.loading.kind == "path" and scene.geometry.kind != "flat_punch":
+            out.append(problem_line("geometry.kind", scene.geometry.kind,
+                                    "smooth indenters on a loading path come with the next "
+                                    "release"))
+        return out
+
+    def solve(self, scene, observers) -> Result:
+        wall = time.perf_counter()
+        setup = make_setup(scene)
+        t_scale = _time_scale(scene, setup)
+        t_end = setup.t_max if math.isfinite(setup.t_max) else DEFAULT_SPAN * t_scale
+
+        def level(n):
+            stepper = Stepper(setup, n, t_scale)
+            with observers.progress(f"n = {n}", None) as update:
+                try:
+                    stepper.run(t_end, update)
+                except KeyboardInterrupt:
+                    stepper.interrupted = True
+            stepper.summary = summarise(stepper)
+            return stepper
+
+        result = ladder.refine(
+            level, _controlled, scene.numerics.rtol, _FIRST_N, ORDER,
+            can_refine=lambda run, n: 2 * len(run.rows) <= MAX_STEPS,
+            interrupted=lambda run: getattr(run, "interrupted", False), extrapolated=True)
+        return _result(scene, setup, result, observers, time.perf_counter() - wall)
+
+
+def _time_scale(scene, setup) -> float:
+    """The run's time scale (steps are about ``1/n`` of it where nothing moves fast): the
+    frozen-history onset bound of a flat punch's pull, else the path's known durations."""
+    if scene.loading.kind == "constant_velocity":
+        t = frozen_detach_time(Problem.from_scene(scene), math.inf)
+        return t if math.isfinite(t) and t > 0.0 else 1.0
+    known = [d.end[1] for d in setup.drives if d.end[0] == "time"]
+    return max(known) if known else 1.0
+
+
+def _controlled(run) -> np.ndarray:
+    return np.array([run.summary.get(name, math.nan) for name in CONTROLLED], dtype=float)
+
+
+def peak(t: np.ndarray, F: np.ndarray, kinks=()):
+    """``(t_peak, F_peak)`` of a sampled history: the largest sample, refined by the parabola
+    through it and its neighbours where the maximum is smooth (not at an event, where the
+    history has a corner, as at an unstable crack's onset)."""
+    i = int(np.argmax(F))
+    if (0 < i < F.size - 1 and i not in kinks and min(F[i - 1], F[i + 1]) > 0.9 * F[i]
+            and t[i - 1] < t[i] < t[i + 1]):
+        t0, t1, t2 = t[i - 1], t[i], t[i + 1]
+        f0, f1, f2 = F[i - 1], F[i], F[i + 1]
+        d1 = (f1 - f0) / (t1 - t0)
+        d2 = (f2 - f1) / (t2 - t1)
+        curv = (d2 - d1) / (t2 - t0)
+        if curv < 0.0:
+            t_v = 0.5 * (t1 + t0) - d1 / (2.0 * curv)
+            if t0 <= t_v <= t2:
+                return t_v, f1 + d1 * (t_v - t1) + curv * (t_v - t1) * (t_v - t0)
+    return float(t[i]), float(F[i])
+
+
+def summarise(stepper) -> dict:
+    """The summary quantities of one run, SI."""
+    s = stepper.setup
+    rows = np.array(stepper.rows)
+    t, H, a, b = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
+    Fc, Ft = rows[:, 5], rows[:, 6]
+    out = {}
+    events = dict((name, when) for when, name in reversed(stepper.events))
+    if "onset" in events:
+        i = int(np.nonzero(t == events["onset"])[0][0])
+        out.update(t_detach=t[i] * s.T, h_detach=H[i] * s.delta, b_detach=b[i] * s.L,
+                   zone_ratio_detach=(b[i] - a[i]) / a[i] if a[i] > 0 else math.nan,
+                   F_contact_detach=Fc[i] * s.F0, F_total_detach=Ft[i] * s.F0, detached=True)
+    else:
+        out["detached"] = False
+    if "separated" in events:
+        out["t_separation"] = events["separated"] * s.T
+    tp, Fp = peak(t, Ft, stepper.kinks)
+    tc, Fcp = peak(t, Fc, stepper.kinks)
+    out.update(F_peak_total=Fp * s.F0, t_peak_total=tp * s.T, F_peak_contact=Fcp * s.F0,
+               t_peak_contact=tc * s.T)
+    return out
+
+
+def _history(stepper, observers) -> dict:
+    s = stepper.setup
+    rows = np.array(stepper.rows)
+    keep = observers.kept_rows(rows.shape[0], np.arange(rows.shape[0]))
+    rows = rows[keep]
+    return {"t": rows[:, 0] * s.T, "h": rows[:, 1] * s.delta, "a": rows[:, 2] * s.L,
+            "b": rows[:, 3] * s.L, "gap": rows[:, 4] * s.delta,
+            "F_contact": rows[:, 5] * s.F0, "F_total": rows[:, 6] * s.F0}
+
+
+def _notes(stepper, scene, estimate, rtol) -> list:
+    s = stepper.setup
+    notes = []
+    for what, t in stepper.notes:
+        if what == "t_max":
+            end = ("separation" if s.until == "separation" else
+                   "the onset" if s.until == "detach" else "the end of the loading path")
+            notes.append(f"{end} not reached before t_max = {t * s.T:.6g} s"
+                         + ("" if scene.numerics.t_max is not None else
+                            " (the default span; set numerics.t_max to go further)"))
+        elif what == "steps":
+            notes.append(f"stopped at t = {t * s.T:.6g} s: {MAX_STEPS} steps in one run")
+    if not estimate <= rtol and not getattr(stepper, "interrupted", False):
+        notes.append(f"not converged: error estimate {estimate:.2g} above rtol {rtol:g} at the "
+                     f"step cap ({MAX_STEPS} steps per level)")
+    return notes
+
+
+def _result(scene, setup, ladder_result, observers, wall) -> Result:
+    finest = ladder_result.finest
+    summary = dict(finest.summary)
+    estimate = ladder_result.estimate
+    if ladder_result.extrapolated is not None:
+        for name, value in zip(CONTROLLED, ladder_result.extrapolated):
+            if math.isfinite(value):
+                summary[name] = float(value)
+    spectrum = scene.material.spectrum()
+    if scene.loading.kind == "constant_velocity":
+        summary.update(analytic.dimensionless_groups(
+            spectrum.G_inf, spectrum.eta, scene.adhesion.sigma_c, scene.adhesion.delta,
+            getattr(scene.geometry, "radius", math.nan), scene.loading.v))
+    summary.update(error_estimate=float(estimate), observed_order=float(ladder_result.order),
+                   n_elements=int(finest.nodes.n), n_steps=len(finest.rows) - 1,
+                   wall_time=wall, t_end=float(finest.now.t * setup.T), solver="contact",
+                   history=scene.model.history, until=setup.until,
+                   cohesive_zone=getattr(scene.geometry, "cohesive_zone", ""))
+    notes = _notes(finest, scene, estimate, scene.numerics.rtol)
+    analytic_values = analytic.predictions(scene) if setup.indenter.kind != "smooth" else {}
+    if setup.indenter.kind != FLAT_EXTERNAL:
+        analytic_values.update({k: math.nan for k in ("seed_linearised_t_detach",)})
+    return Result.build(summary, analytic_values, _history(finest, observers), notes=notes,
+                        complete=not getattr(finest, "interrupted", False), problem=setup)

@@ -1,0 +1,119 @@
+"""Machine spring and force control: the lift at the end of a step is one more unknown, with
+the force balance as one more condition; damped Newton on both (a finite-difference Jacobian:
+the unknowns are few, each evaluation advances every element)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import contact_phases as phases
+from . import contact_state as st
+
+
+def solve(stepper, step, H_guess, force_residual):
+    """The evaluation whose lift balances ``force_residual`` and whose phase conditions hold.
+
+    Where the phase fixes its edges explicitly (bonded, pinned, apart) this is Newton on the
+    lift alone. Elsewhere the phase's own root finding runs inside a bracketed search on the
+    lift; a flat punch's edge is first tried held (the edge sticks while the gap stays below
+    delta), and that lift starts the search if it does not."""
+    now = step.now
+    explicit = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.APART: phases.apart}
+    scale = _force_scale(stepper, now)
+    if now.phase in explicit:
+        build = explicit[now.phase]
+        out = _newton(lambda z: _with_force(build(step, z[0]), force_residual),
+                      np.array([H_guess]), np.array([max(abs(now.H), 1.0)]), scale)
+        if out is None:
+            raise phases.Lost("balance")
+        return out[0]
+    if now.phase == st.CONTACT_PHASE and stepper.setup.flat:
+        held = _newton(lambda z: _with_force(_stick(step, z[0]), force_residual),
+                       np.array([H_guess]), np.array([max(abs(now.H), 1.0)]), scale)
+        if held is not None:
+            if held[0].gap <= 1.0:
+                return held[0]
+            H_guess = held[0].H
+    return _nested(stepper, step, H_guess, force_residual)
+
+
+def _with_force(ev, force_residual):
+    return ev, np.array([force_residual(ev)])
+
+
+def _stick(step, H):
+    return step.evaluate(step.now.alpha, phases._edge_zone(step, H, step.now.alpha), H)
+
+
+def _force_scale(stepper, now):
+    machine = stepper.setup.machine or 0.0
+    return np.array([max(1.0, abs(now.F_total), machine * abs(now.H))])
+
+
+def _nested(stepper, step, H_guess, force_residual):
+    """The phase's root finding inside, the lift outside (bracketed, nearest ``H_guess``);
+    a lift at which the phase has no state counts as beyond the search's domain."""
+    cache = {}
+
+    def residual(H):
+        try:
+            cache[H] = ev = stepper._phase(step, H)
+        except phases.Lost:
+            return math.nan
+        return force_residual(ev)
+
+    r0 = residual(H_guess)
+    if math.isnan(r0):
+        H_guess = step.now.H
+        r0 = residual(H_guess)
+    if math.isnan(r0):
+        raise phases.Lost("balance")
+    H = phases._root(residual, H_guess, r0, H_guess + 1e-9 * max(abs(H_guess), 1.0),
+                     -math.inf, math.inf)
+    if H is None:
+        raise phases.Lost("balance")
+    return cache.get(H) or stepper._phase(step, H)
+
+
+def _newton(residual, z0, scale, rscale, tol=1e-12, max_iter=30):
+    """Damped Newton on ``residual(z) -> (evaluation, vector)``: ``scale`` sizes the unknowns
+    (its sign the side of the finite differences), ``rscale`` the residuals; None when it
+    fails."""
+    z = z0.astype(float)
+    try:
+        ev, r = residual(z)
+    except phases.Lost:
+        return None
+    for _ in range(max_iter):
+        if np.all(np.abs(r) <= tol * rscale):
+            return ev, r
+        n = z.size
+        J = np.empty((n, n))
+        for j in range(n):
+            h = 1e-7 * scale[j]
+            dz = z.copy()
+            dz[j] += h
+            try:
+                J[:, j] = (residual(dz)[1] - r) / h
+            except phases.Lost:
+                return None
+        try:
+            dx = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            return None
+        norm = np.linalg.norm(r / rscale)
+        lam = 1.0
+        while lam > 1.0 / 1024:
+            try:
+                ev_t, r_t = residual(z + lam * dx)
+                if np.linalg.norm(r_t / rscale) < (1.0 - 1e-4 * lam) * norm:
+                    break
+            except phases.Lost:
+                pass
+            lam *= 0.5
+        else:
+            return (ev, r) if np.all(np.abs(r) <= 1e-9 * rscale) else None
+        z, ev, r = z + lam * dx, ev_t, r_t
+    return (ev, r) if np.all(np.abs(r) <= 1e-9 * rscale) else None

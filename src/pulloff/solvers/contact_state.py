@@ -1,0 +1,96 @@
+"""The contact stepper's state: the foundation's elements, and the instant between steps."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+FREE, CONTACT = 0, 1
+
+#: Phases of the contact (MODEL.md sections 3, 6 and 9).
+BONDED = "bonded"  # flat punch, zone outside: a at the rim, b from the edge condition
+PINNED = "pinned"  # flat punch, zone on the face: b at the rim, a from the edge condition
+CONTACT_PHASE = "contact"  # a and b both free (a recedes, advances or sticks)
+ZONE = "zone"  # no contact, the zone alone pulls the surface (a = 0)
+APART = "apart"  # no zone: the surfaces are further apart than delta
+DONE = "done"
+
+
+class Nodes:
+    """Foundation elements sorted by position ``xi``: the modes ``Y`` of a free element (valid
+    at ``t_last``; elements beyond the zone relax unloaded and are brought up to date only
+    when the zone reaches them), and for an element in contact the memory ``D`` of its arms
+    at the time ``tj`` it joined (see :meth:`pulloff.solvers.contact.Stepper.contact_arms`)."""
+
+    def __init__(self, n_modes: int, n_arms: int, capacity: int = 256):
+        self.n = 0
+        self.xi = np.zeros(capacity)
+        self.Y = np.zeros((capacity, max(n_modes, 1)))
+        self.status = np.zeros(capacity, dtype=np.int64)
+        self.D = np.zeros((capacity, max(n_arms, 1)))
+        self.tj = np.zeros(capacity)
+        self.t_last = np.zeros(capacity)
+        self.xi_max = -math.inf  # the furthest any element ever was: beyond, the solid is virgin
+
+    def _grow(self):
+        for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+            old = getattr(self, name)
+            new = np.zeros((2 * old.shape[0],) + old.shape[1:], dtype=old.dtype)
+            new[:self.n] = old[:self.n]
+            setattr(self, name, new)
+
+    def insert(self, x: float, Y=None, status: int = FREE, D=None, tj: float = 0.0,
+               t_last: float = 0.0) -> int:
+        """Put an element at ``x`` (kept sorted); returns its index."""
+        if self.n == self.xi.shape[0]:
+            self._grow()
+        i = int(np.searchsorted(self.xi[:self.n], x))
+        for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+            arr = getattr(self, name)
+            arr[i + 1:self.n + 1] = arr[i:self.n]
+        self.xi[i] = x
+        self.Y[i] = 0.0 if Y is None else Y
+        self.status[i] = status
+        self.D[i] = 0.0 if D is None else D
+        self.tj[i] = tj
+        self.t_last[i] = t_last
+        self.n += 1
+        self.xi_max = max(self.xi_max, x)
+        return i
+
+    def near(self, x: float, tol: float) -> bool:
+        """Whether an element lies within ``tol`` of ``x``."""
+        i = int(np.searchsorted(self.xi[:self.n], x))
+        return any(0 <= j < self.n and abs(self.xi[j] - x) <= tol for j in (i - 1, i))
+
+    def below(self, x: float) -> int:
+        """Number of elements with ``xi < x``."""
+        return int(np.searchsorted(self.xi[:self.n], x))
+
+
+@dataclass
+class Instant:
+    """Everything known at one time (dimensionless): lift and its rate, the edges, the phase,
+    the forces, the arms' filtered lift ``Hf`` and the running segment."""
+
+    t: float
+    H: float
+    Hdot: float
+    alpha: float
+    beta: float
+    phase: str
+    gap: float = math.nan
+    F_contact: float = 0.0
+    F_total: float = 0.0
+    Hf: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    segment: int = 0
+    segment_start: float = 0.0
+    segment_sign: float = 1.0  # which way the segment's target lies from its start
+    centre_u: float = math.nan  # displacement of the element at the centre
+    driver: float = 0.0  # where the machine's driver is (behind a spring)
+
+    def copy(self, **changes) -> "Instant":
+        changes.setdefault("Hf", self.Hf.copy())
+        return replace(self, **changes)

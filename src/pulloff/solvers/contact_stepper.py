@@ -1,0 +1,653 @@
+"""The contact stepper: any axisymmetric indenter, any rheology, any loading path, with the contact
+edge ``a`` and the zone end ``b`` both free to move (MODEL.md sections 3, 6 and 9).
+
+Units and element law: :mod:`.contact_setup`. One step (:mod:`.contact_step`) advances every
+element exactly for its rheology under the load the trial edges give; this module chooses the
+trial edges phase by phase, sizes the steps, finds events inside a step and lands a step on
+them, and keeps the foundation's elements:
+
+- elements are placed where the zone sweeps: where a receding contact edge releases them and
+  where the zone end enters the virgin solid, spaced at most ``zone width / M``; they keep
+  their place in ``x``, so elements do not grow with the steps, only with the swept length;
+- the zone end is found from ``gap(b) = delta`` (a smooth indenter, or any indenter once the
+  edge recedes), or from the edge condition while a flat punch's rim pins the edge (bonded,
+  the seed) or the zone (on the face); the contact edge from the edge condition while it
+  recedes, from contact (a free element reaching the indenter) while it advances.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kernels import contact as K
+from . import contact_balance as balance
+from . import contact_phases as phases
+from . import contact_replay as replay
+from . import contact_state as st
+from .contact_setup import FLAT_EXTERNAL, FLAT_INTERNAL, Setup
+from .contact_step import Evaluation, Step
+
+#: Nodes per zone width at resolution n = 64 (they grow like sqrt(n): the gap quadrature is
+#: fourth order in their spacing, the step second order).
+_NODES_PER_ZONE = 12.0
+#: Elements placed per step where the zone end enters virgin solid (evenly in angle).
+ENTRY_NODES = 4
+#: Steps a run may take (per level).
+MAX_STEPS = 40_000
+
+
+class NoSolution(Exception):
+    """No state on the current branch at the end of a trial step (it may be a jump)."""
+
+
+class Stepper:
+    """One pass at resolution ``n`` (about ``n`` steps per unit of the step measure)."""
+
+    def __init__(self, setup: Setup, n: int, t_scale: float):
+        self.setup = setup
+        self.n = n
+        self.t_scale = t_scale
+        law = setup.law
+        self.nodes = st.Nodes(law.n_modes, law.kappa_arms.size)
+        self.per_zone = _NODES_PER_ZONE * math.sqrt(n / 64.0)
+        self.rows = []
+        self.row_Hf = []  # the arms' filtered lift at each row (a replay needs it)
+        self.events = []  # (t, name)
+        self.notes = []  # (what, t): why a run stopped early
+        self.kinks = set()  # rows at events: the history may have a corner there
+        self.phase_row = 0  # the row where the current phase began
+        self.segment = 0
+        self.last_dt = None
+        self.now = self._start()
+        self.before = None
+        self._begin_segment()
+
+    # --- the loading -----------------------------------------------------------------------
+    @property
+    def drive(self):
+        return self.setup.drives[self.segment]
+
+    @property
+    def lift_driven(self) -> bool:
+        """Whether the lift is prescribed (a rigid machine, or a speed segment)."""
+        return self.setup.machine is None and (self.setup.control == "displacement"
+                                               or self.drive.kind == "speed")
+
+    # --- start -------------------------------------------------------------------------------
+    def _start(self) -> st.Instant:
+        s = self.setup
+        law = s.law
+        Hf = np.zeros(law.kappa_arms.size)
+        H0 = s.h0
+        Hdot = self.drive.rate if self.lift_driven and self.drive.kind == "speed" else 0.0
+        kind = s.indenter.kind
+        if kind in (FLAT_EXTERNAL, FLAT_INTERNAL):
+            Q_b = law.kappa_instant * H0 + law.c * Hdot if law.maxwell else \
+                law.kappa_inf * H0 + law.c * Hdot
+            if kind == FLAT_EXTERNAL:
+                alpha, beta, phase = 1.0, math.hypot(1.0, max(Q_b, 0.0)), st.BONDED
+            elif Q_b >= 1.0:
+                alpha, beta, phase = 0.0, 1.0, st.ZONE
+            else:
+                alpha, beta, phase = math.sqrt(1.0 - max(Q_b, 0.0) ** 2), 1.0, st.PINNED
+            self._preload(alpha, beta, Q_b, H0)
+        else:
+            alpha, beta, phase = 0.0, 0.0, st.APART
+            self.nodes.insert(0.0, t_last=0.0)
+        now = st.Instant(0.0, H0, Hdot, alpha, beta, phase, Hf=Hf)
+        ev = Step(self, now, 1e-300, None).evaluate(alpha, beta, H0) if phase != st.APART \
+            else None
+        if ev is not None:
+            now.gap, now.F_contact, now.F_total = ev.gap, ev.F_contact, ev.F_total
+        else:
+            now.gap = H0 - 0.0
+        self._row(now)
+        return now
+
+    def _preload(self, alpha, beta, Q_b, H0):
+        """Elements inside the zone at t = 0, graded toward its end; a damped solid has not
+        moved yet, an elastic one follows its load at once (MODEL.md, settled questions)."""
+        law = self.setup.law
+        if beta <= alpha:
+            return
+        m = max(8, int(math.ceil(self.per_zone * 2)))
+        theta = np.linspace(0.0, 0.5 * math.pi, m)
+        for x in alpha + (beta - alpha) * np.sin(theta[1:]):
+            self.nodes.insert(float(x), t_last=0.0)
+        del Q_b, H0  # an elastic element has no modes: its U follows Q each evaluation
+        if law.n_modes:
+            self.nodes.Y[:self.nodes.n] = 0.0
+
+    # --- evaluation details the step needs -----------------------------------------------
+    def contact_memory_arms(self, xi, t):
+        """``D_i e^{-(t - tj)/tau_i}`` of a contact element at ``xi`` (a Maxwell solid), arm by
+        arm: what its dashpots remember of how it joined (``E_i = Hf_i + g + this``),
+        interpolated between contact elements; 0 where none joined by contact (a flat punch
+        bonded from the start)."""
+        nodes = self.nodes
+        law = self.setup.law
+        m = law.tau_arms.size
+        idx = np.nonzero(nodes.status[:nodes.n] == st.CONTACT)[0]
+        if idx.size == 0:
+            return np.zeros(m)
+        mem = nodes.D[idx, :m] * np.exp(-(t - nodes.tj[idx])[:, None] / law.tau_arms)
+        return np.array([np.interp(xi, nodes.xi[idx], mem[:, i]) for i in range(m)])
+
+    def contact_memory(self, xi, t):
+        """``sum_i kappa_i D_i e^{-(t - tj)/tau_i}``: the arms' memory in the contact load."""
+        return float(np.dot(self.setup.law.kappa_arms, self.contact_memory_arms(xi, t)))
+
+    def finish_evaluation(self, step: Step, ev: Evaluation, bp) -> None:
+        """Gap, edge loads and forces of an evaluation."""
+        s = self.setup
+        ind = s.indenter
+        nodes = self.nodes
+        alpha, beta, H = ev.alpha, ev.beta, ev.H
+        xi = ev.xi
+        centre = np.nonzero(xi == 0.0)[0]
+        ev.centre_u = float(ev.U[centre[0]]) if centre.size else math.nan
+        if beta <= 0.0:
+            ev.gap = H - ev.centre_u if centre.size else math.inf
+            ev.edge_load = ev.edge_free_u = math.nan
+            return
+        ell = math.sqrt(max((beta - alpha) * (beta + alpha), 0.0))
+        if beta > nodes.xi_max * (1.0 + 1e-12) + 1e-300 and beta > step.now.beta:
+            U_beta = 0.0  # the zone end enters virgin solid, still at rest
+        else:
+            U_beta = math.nan
+        U_alpha = H + ind.g(alpha) if alpha > 0.0 else ev.centre_u
+        integral = K.free_gap_integral(xi, ev.U, 0, xi.size, alpha, beta, U_alpha, U_beta)
+        contact = K.profile_integral(ind.C, ind.n, alpha, beta)
+        ev.gap = ((2.0 / math.pi) * H * math.atan2(ell, alpha) + ind.f(beta)
+                  - (2.0 / math.pi) * (contact + integral))
+        ev.edge_load = step.contact_load(alpha, H, ev.Hdot, ev.Hf) if alpha > 0.0 else 0.0
+        ev.edge_free_u = self._free_u_at(xi, ev.U, alpha)
+        zone_force = 2.0 * (beta * beta * math.atan2(ell, alpha) - alpha * ell)
+        ev.F_contact = 4.0 * self._contact_force(step, ev)
+        ev.F_total = ev.F_contact + zone_force
+
+    def _free_u_at(self, xi, U, alpha):
+        """A free element's displacement at ``alpha``: the cubic through the nearest elements
+        on both sides (the ones the advancing edge captures count as if still free)."""
+        j = int(np.searchsorted(xi, alpha))
+        lo, hi = max(0, j - 2), min(xi.size, j + 2)
+        if hi - lo < 2:
+            return math.nan
+        return K.interpolate_cubic(xi[lo:hi].copy(), U[lo:hi].copy(), alpha)
+
+    def _contact_force(self, step, ev):
+        """``int_0^alpha Q dxi`` of the contact elements."""
+        law = self.setup.law
+        ind = self.setup.indenter
+        a = ev.alpha
+        if a <= 0.0:
+            return 0.0
+        base = law.kappa_inf * (ev.H * a + ind.g_integral(a))
+        if not law.maxwell:
+            return base + law.c * ev.Hdot * a
+        base += a * float(np.dot(law.kappa_arms, ev.H - ev.Hf))
+        return base - self._memory_integral(a, step.now.t + step.dt)
+
+    def _memory_integral(self, alpha, t):
+        """``int_0^alpha`` of :meth:`contact_memory` (trapezoid over the contact elements)."""
+        nodes = self.nodes
+        law = self.setup.law
+        idx = np.nonzero((nodes.status[:nodes.n] == st.CONTACT) & (nodes.xi[:nodes.n] < alpha))[0]
+        if idx.size == 0:
+            return 0.0
+        x = np.append(nodes.xi[idx], alpha)
+        m = law.tau_arms.size
+        mem = (nodes.D[idx, :m] * np.exp(-(t - nodes.tj[idx])[:, None] / law.tau_arms)) @ \
+            law.kappa_arms
+        mem = np.append(mem, self.contact_memory(alpha, t))
+        return float(np.trapezoid(mem, x)) if hasattr(np, "trapezoid") else float(np.trapz(mem, x))
+
+    # --- history ---------------------------------------------------------------------------
+    def _row(self, now):
+        self.rows.append((now.t, now.H, now.alpha, now.beta, now.gap, now.F_contact,
+                          now.F_total, float(self.drive.index)))
+        self.row_Hf.append(now.Hf.copy())
+
+    # --- where new elements go ------------------------------------------------------------
+    def spacing(self, now) -> float:
+        """Target distance between elements: a ``per_zone``-th of the zone's width."""
+        width = now.beta - now.alpha if now.beta > now.alpha else now.beta
+        return max(width, 1e-9 * max(now.beta, 1.0)) / self.per_zone
+
+    def new_elements(self, step, alpha, beta):
+        """Positions of the elements a trial step places: ``step.k_alpha`` evenly over what a
+        receding flat punch releases (ending on the new edge), ``step.k_beta`` over what the
+        zone end adds of virgin solid (ending on the new zone end)."""
+        now = step.now
+        out = []
+        if self.setup.flat and alpha < now.alpha and step.k_alpha:
+            k = step.k_alpha
+            out.append(now.alpha + (alpha - now.alpha) * np.arange(1, k + 1) / k)
+        start = max(now.beta, self.nodes.xi_max)
+        if beta > start and step.k_beta:
+            # Evenly spaced in the angle theta = acos(x/b) the gap is integrated in: the load
+            # of an element that just entered grows like a power of its distance to b, which
+            # is smooth in theta, not in x.
+            k = step.k_beta
+            out.append(beta - (beta - start) * ((k - np.arange(1, k + 1)) / k) ** 2)
+        return np.concatenate(out) if out else np.zeros(0)
+
+    def make_step(self, dt) -> Step:
+        """A trial step of ``dt``, with the number of new elements chosen from the motion the
+        last step predicts."""
+        step = Step(self, self.now, dt, self.before)
+        now, before = self.now, self.before
+        h = self.spacing(now)
+        grow_a = grow_b = 0.0
+        if before is not None and now.t > before.t:
+            rate = dt / (now.t - before.t)
+            grow_a = max(before.alpha - now.alpha, 0.0) * rate
+            grow_b = max(now.beta - before.beta, 0.0) * rate
+        step.k_alpha = max(1, int(math.ceil(grow_a / h)))
+        step.k_beta = ENTRY_NODES
+        return step
+
+    # --- running -----------------------------------------------------------------------------
+    def run(self, t_end: float, progress=None) -> None:
+        """Step until the loading ends (or the run's end), ``t_end`` or ``MAX_STEPS``."""
+        while self.now.phase != st.DONE:
+            if self.now.t >= t_end * (1.0 - 1e-14):
+                self.notes.append(("t_max", self.now.t))
+                break
+            if len(self.rows) > MAX_STEPS:
+                self.notes.append(("steps", self.now.t))
+                break
+            self._advance(self._next_dt(t_end))
+            if progress is not None:
+                progress(1)
+
+    def _next_dt(self, t_end) -> float:
+        now, before = self.now, self.before
+        dt = self.t_scale / self.n
+        if before is not None and now.t > before.t:
+            dt_prev = now.t - before.t
+            scale = max(1.0, now.beta)
+            rate = (1.0 / self.t_scale
+                    + (abs(now.alpha - before.alpha) + abs(now.beta - before.beta))
+                    / (scale * dt_prev))
+            dt = min(1.0 / (self.n * rate), 2.0 * dt_prev)
+        elif self.last_dt is not None:
+            dt = min(dt, self.last_dt)
+        return min(dt, t_end - now.t, self._segment_left())
+
+    def _segment_left(self) -> float:
+        name, value = self.drive.end
+        if name == "time":
+            return max(self.now.segment_start + value - self.now.t, 0.0) or math.inf
+        return math.inf
+
+    def _advance(self, dt) -> None:
+        if self.now.phase == st.ZONE and self._separates_within(dt):
+            return
+        step = self.make_step(dt)
+        try:
+            ev = self.solve(step)
+        except phases.Lost as lost:
+            self._branch_end(dt, lost.what)
+            return
+        event = self.crossed(ev)
+        if event is None:
+            self.commit(step, ev)
+            return
+        step, ev = self._locate(event, dt)
+        self.commit(step, ev)
+        self.transition(event)
+
+    def _separates_within(self, dt) -> bool:
+        """The zone alone vanishes like ``b ~ sqrt(t_sep - t)``, where its equation becomes
+        ill-conditioned: ``b^2`` is smooth in time, so once the quadratic through its last
+        three values puts ``b = 0`` within the next step, the separation is that root."""
+        zone_rows = [r for r in self.rows[self.phase_row:] if r[3] > 0.0]
+        if len(zone_rows) < 3:
+            return False
+        (t0, b0), (t1, b1), (t2, b2) = [(r[0], r[3] * r[3]) for r in zone_rows[-3:]]
+        if not (t0 < t1 < t2) or b2 >= b1:
+            return False
+        c = np.polyfit([t0 - t2, t1 - t2, 0.0], [b0, b1, b2], 2)
+        roots = [r.real for r in np.roots(c) if abs(r.imag) < 1e-12 and r.real > 0.0]
+        if not roots or min(roots) > dt:
+            return False
+        t_sep = self.now.t + min(roots)
+        now = self.now
+        H = now.H + (t_sep - now.t) * (self.drive.rate if self.lift_driven
+                                        and self.drive.kind == "speed" else now.Hdot)
+        self.before, self.last_dt = now, t_sep - now.t
+        self.now = now.copy(t=t_sep, H=H, beta=0.0, gap=1.0, F_total=0.0, F_contact=0.0)
+        self._row(self.now)
+        self.transition("separation")
+        return True
+
+    def solve(self, step) -> Evaluation:
+        """The state at the end of ``step`` that satisfies the phase's conditions."""
+        if self.lift_driven:
+            drive = self.drive
+            H = self.now.H + (drive.rate * step.dt if drive.kind == "speed" else 0.0)
+            return self._phase(step, H)
+        return self._balanced(step)
+
+    def _phase(self, step, H) -> Evaluation:
+        now, before = self.now, self.before
+        guess_a, guess_b = now.alpha, now.beta
+        if before is not None and now.t > before.t:
+            f = step.dt / (now.t - before.t)
+            guess_a = max(now.alpha + f * (now.alpha - before.alpha), 0.0)
+            guess_b = max(now.beta + f * (now.beta - before.beta), 0.0)
+        phase = now.phase
+        if phase == st.BONDED:
+            return phases.bonded(step, H)
+        if phase == st.PINNED:
+            return phases.pinned(step, H)
+        if phase == st.CONTACT_PHASE:
+            if self.setup.flat:
+                return phases.flat_contact(step, H, guess_a)
+            return phases.smooth_contact(step, H, guess_a, guess_b)
+        if phase == st.ZONE:
+            return phases.zone_only(step, H, guess_b)
+        return phases.apart(step, H)
+
+    def _balanced(self, step) -> Evaluation:
+        """The lift at the end of the step balances the machine spring or the driven force:
+        Newton on the lift and the phase's own unknown together."""
+        s = self.setup
+        now = self.now
+        drive = self.drive
+        if s.machine is not None:
+            driver = now.driver + drive.rate * step.dt
+
+            def force_residual(ev):
+                return s.machine * (driver - ev.H) - ev.F_total
+        else:
+            target = now.F_total + (drive.rate * step.dt if drive.kind == "force_rate" else 0.0)
+
+            def force_residual(ev):
+                return target - ev.F_total
+        guess = now.H
+        if self.before is not None and now.t > self.before.t:
+            guess = now.H + (now.H - self.before.H) * step.dt / (now.t - self.before.t)
+        return balance.solve(self, step, guess, force_residual)
+
+    # --- events ------------------------------------------------------------------------------
+    def event_values(self, x) -> dict:
+        """Continuous functions of an instant or evaluation whose sign change is an event (from
+        negative to non-negative)."""
+        phase = self.now.phase
+        out = {}
+        if phase in (st.BONDED, st.PINNED):
+            out["onset"] = x.gap - 1.0
+        centre_gap = x.H - x.centre_u if math.isfinite(x.centre_u) else math.nan
+        if phase == st.APART and math.isfinite(centre_gap):
+            out["birth"] = 1.0 - centre_gap
+        if phase == st.ZONE and math.isfinite(centre_gap):
+            if not self.setup.flat:  # a flat punch's face does not re-bond
+                out["touch"] = -centre_gap
+            out["separation"] = centre_gap - 1.0
+        name, value = self.drive.end
+        t = x.t if isinstance(x, st.Instant) else self.now.t + x.dt
+        if name == "time":
+            out["end"] = t - (self.now.segment_start + value)
+        elif name in ("lift", "force"):
+            current = x.H if name == "lift" else x.F_total
+            out["end"] = self.now.segment_sign * (current - value)
+        return out
+
+    def crossed(self, ev):
+        """The first event between now and ``ev`` (by a linear guess of where it falls)."""
+        before = self.event_values(self.now)
+        after = self.event_values(ev)
+        best, best_frac = None, math.inf
+        for name, v1 in after.items():
+            v0 = before.get(name, math.nan)
+            if math.isfinite(v0) and math.isfinite(v1) and v0 < 0.0 <= v1:
+                frac = -v0 / (v1 - v0)
+                if frac < best_frac:
+                    best, best_frac = name, frac
+        return best
+
+    def _locate(self, event, dt):
+        """Re-solve the step so that it ends on ``event`` (a root in its length)."""
+        v0 = self.event_values(self.now)[event]
+        cache = {}
+
+        def value(d):
+            step = self.make_step(d)
+            ev = self.solve(step)
+            ev.dt = d
+            cache[d] = (step, ev)
+            return self.event_values(ev)[event]
+
+        v1 = value(dt)
+        lo, hi, f_lo, f_hi = 0.0, dt, v0, v1
+        for _ in range(100):
+            # Illinois-flavoured regula falsi, falling back to bisection.
+            d = hi - f_hi * (hi - lo) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * (lo + hi)
+            if not lo < d < hi:
+                d = 0.5 * (lo + hi)
+            try:
+                f = value(d)
+            except phases.Lost:
+                hi, f_hi = d, abs(f_hi)  # the branch ends before: the event is earlier
+                continue
+            if f >= 0.0:
+                hi, f_hi = d, f
+                f_lo *= 0.5
+            else:
+                lo, f_lo = d, f
+                f_hi *= 0.5
+            if abs(f) <= 1e-13 or hi - lo <= 1e-15 * max(self.now.t + dt, self.t_scale):
+                break
+        return cache[hi] if hi in cache else cache[d]
+
+    def _branch_end(self, dt, what) -> None:
+        """No state of the phase at the end of the step. If there is none even a moment
+        later, the branch ends here (at a natural limit, or by a jump, resolved as two rows
+        at one time); otherwise step to the longest step that works (by bisection) and try
+        again from there."""
+        try:
+            self.solve(self.make_step(1e-12 * dt))
+        except phases.Lost:
+            self.transition(what)
+            return
+        if self._at_limit(what):
+            self.transition(what)
+            return
+        lo, hi = 0.0, dt
+        best = None
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            step = self.make_step(mid)
+            try:
+                ev = self.solve(step)
+            except phases.Lost:
+                hi = mid
+                continue
+            if self.crossed(ev) is not None:
+                hi = mid  # an event comes first: take it at its own time
+                continue
+            lo, best = mid, (step, ev)
+            if self._at_limit(what, ev) or hi - lo <= 1e-14 * max(self.now.t + hi, 1.0):
+                break
+        if best is None:
+            self.transition(what)
+            return
+        self.commit(*best)
+        if self._at_limit(what) or lo <= 1e-10 * self.t_scale:
+            self.transition(what)  # the natural end, or only a vanishing step still works
+
+    def _at_limit(self, what, now=None) -> bool:
+        """Whether the state (now, or an evaluation) is at the natural end of its branch: the
+        edge at the centre, or the zone gone."""
+        now = now or self.now
+        # A sliver this thin released at once changes the gap by ~(sliver)^2.
+        if what == "contact":
+            return now.alpha <= 1e-6 * max(now.beta, 1.0)
+        if what == "zone":
+            return now.beta <= 1e-6
+        return False
+
+    # --- committing a step ---------------------------------------------------------------------
+    def commit(self, step, ev) -> None:
+        """Make the end of ``step`` the new instant: element states, statuses, new elements."""
+        nodes = self.nodes
+        lo, hi = ev.lo, ev.hi
+        t1 = self.now.t + step.dt
+        status = nodes.status[lo:hi]
+        x = nodes.xi[lo:hi]
+        released = (status == st.CONTACT) & (x > ev.alpha)
+        captured = np.nonzero((status == st.FREE) & (x <= ev.alpha) & (ev.alpha > 0.0))[0]
+        for j in captured:  # before the modes move on: capture needs them at the start
+            self._capture(step, ev, lo + j)
+        nodes.Y[lo:hi] = ev.Y[~ev.virtual]
+        nodes.t_last[lo:hi] = t1
+        status[released] = st.FREE
+        for xv, Yv in zip(ev.xi[ev.virtual], ev.Y[ev.virtual]):
+            nodes.insert(float(xv), Yv, st.FREE, t_last=t1)
+        self.before = self.now
+        self.last_dt = step.dt
+        self.now = self.now.copy(t=t1, H=ev.H, Hdot=ev.Hdot, alpha=ev.alpha, beta=ev.beta,
+                                 gap=ev.gap, F_contact=ev.F_contact, F_total=ev.F_total,
+                                 Hf=ev.Hf.copy(), centre_u=ev.centre_u,
+                                 driver=self.now.driver + self._driver_rate() * step.dt)
+        self._row(self.now)
+        replay.refine(self)
+
+    def _driver_rate(self) -> float:
+        drive = self.drive
+        return drive.rate if drive.kind == "speed" else 0.0
+
+    def _capture(self, step, ev, i) -> None:
+        """Element ``i`` joins the contact inside the step: remember how (Maxwell arms)."""
+        nodes = self.nodes
+        nodes.status[i] = st.CONTACT
+        law = self.setup.law
+        ap = step.path("alpha", ev.alpha)
+        from .contact_step import _crossing
+
+        s_c = _crossing(ap, nodes.xi[i])
+        nodes.tj[i] = self.now.t + s_c * step.dt
+        if not law.maxwell:
+            return
+        bp = step.path("beta", ev.beta)
+        ints = np.zeros(law.n_modes)
+        K.load_integrals(bp[0], bp[1], bp[2], nodes.xi[i], 0.0, s_c, step.mus, law.n_modes,
+                         step.w3, ints)
+        Y_c = np.exp(-step.mus * s_c) * nodes.Y[i, :law.n_modes] + law.z * step.dt * ints
+        E = law.V @ Y_c
+        nodes.D[i, :law.tau_arms.size] = (E - step.filtered_lift(ev.H, s_c)
+                                          - self.setup.indenter.g(nodes.xi[i]))
+
+    # --- transitions -----------------------------------------------------------------------------
+    def transition(self, what) -> None:
+        """Apply an event at the current instant (the step was landed on it)."""
+        now = self.now
+        self.before = None  # the edges may kink here: paths restart
+        self.phase_row = len(self.rows) - 1
+        self.events.append((now.t, what))
+        self.kinks.add(len(self.rows) - 1)
+        if sum(t == now.t for t, _ in self.events[-12:]) > 10:  # a bug, not input
+            raise RuntimeError(f"no progress at t = {now.t}: events {self.events[-12:]}")
+        if what == "onset":
+            now.phase = st.CONTACT_PHASE
+            return self._physical_end("onset")
+        if what == "strength":
+            self.events.append((now.t, "onset"))
+            self._release_all()
+            now.phase = st.ZONE
+            return self._physical_end("onset")
+        if what == "contact":
+            self._release_all()
+            now.phase = st.ZONE
+            return
+        if what in ("separation", "zone", "balance"):
+            if what == "zone" and self._growing_zone():
+                return self._touch()
+            now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
+            self.events.append((now.t, "separated"))
+            self._row(now)
+            return self._physical_end("separation")
+        if what == "birth":
+            now.phase = st.ZONE
+            return
+        if what in ("touch", "advance"):
+            return self._touch()
+        if what == "end":
+            return self._next_segment()
+        raise RuntimeError(f"unknown event {what!r}")  # a bug, not input
+
+    def _growing_zone(self) -> bool:
+        """Whether a zone-only branch ended while the zone grew (an approach: the surface
+        jumps into contact), not while it shrank (the surfaces come apart). A flat punch
+        never re-bonds."""
+        rows = self.rows
+        return (not self.setup.flat and len(rows) > 2 and rows[-1][3] > rows[-2][3]
+                and self.events[-2:-1] != [(self.now.t, "contact")])
+
+    def _touch(self) -> None:
+        """The surface meets the indenter at the centre: contact begins there."""
+        now = self.now
+        nodes = self.nodes
+        if nodes.n and nodes.xi[0] == 0.0:
+            nodes.status[0] = st.CONTACT
+            nodes.tj[0] = now.t
+            law = self.setup.law
+            if law.maxwell:
+                E = law.V @ nodes.Y[0, :law.n_modes]
+                nodes.D[0, :law.tau_arms.size] = E - now.Hf
+        now.phase = st.CONTACT_PHASE
+        now.alpha = 0.0
+
+    def _release_all(self) -> None:
+        """The contact is lost at once: its elements go free with their contact state (a
+        flat punch's bonded elements get elements of their own first)."""
+        now = self.now
+        nodes = self.nodes
+        law = self.setup.law
+        if self.setup.flat and now.alpha > 0.0:
+            count = max(2, int(math.ceil(now.alpha / self.spacing(now))))
+            for x in np.linspace(0.0, now.alpha, count + 1)[:-1]:
+                if not nodes.near(float(x), 1e-14):
+                    nodes.insert(float(x), status=st.CONTACT, t_last=now.t)
+        elif not nodes.near(0.0, 0.0):
+            nodes.insert(0.0, status=st.CONTACT, t_last=now.t)
+        idx = np.nonzero((nodes.status[:nodes.n] == st.CONTACT)
+                         & (nodes.xi[:nodes.n] <= now.alpha))[0]
+        step = Step(self, now, 1e-300, None)
+        for i in idx:
+            if law.n_modes:
+                nodes.Y[i, :law.n_modes] = step.released_modes(nodes.xi[i], 0.0, now.H)
+            nodes.status[i] = st.FREE
+            nodes.t_last[i] = now.t
+        now.alpha = 0.0
+
+    def _physical_end(self, name) -> None:
+        """An onset or separation: the end of the run or of the segment waiting for it."""
+        if self.setup.until == "detach" and name == "onset":
+            self.now.phase = st.DONE
+        elif self.setup.until == "separation" and name == "separation":
+            self.now.phase = st.DONE
+        elif self.drive.end == ("event", name):
+            self._next_segment()
+
+    def _next_segment(self) -> None:
+        if self.segment + 1 >= len(self.setup.drives):
+            self.now.phase = st.DONE
+            return
+        self.segment += 1
+        self._begin_segment()
+
+    def _begin_segment(self) -> None:
+        now = self.now
+        now.segment = self.segment
+        now.segment_start = now.t
+        name, value = self.drive.end
+        if name in ("lift", "force"):
+            current = now.H if name == "lift" else now.F_total
+            now.segment_sign = 1.0 if value >= current else -1.0
+        if self.lift_driven and self.drive.kind == "speed":
+            now.Hdot = self.drive.rate
