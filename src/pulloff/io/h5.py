@@ -16,6 +16,8 @@ from __future__ import annotations
 import contextlib
 import datetime as _dt
 import os
+import socket
+import stat
 import tempfile
 from pathlib import Path
 
@@ -49,27 +51,165 @@ def result_to_record(result, scene_yaml: str) -> dict:
     }
 
 
+class OutputError(ValueError):
+    """An output that cannot or must not be written; the message names the key and the path
+    the user gave (never a temporary file)."""
+
+
+_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISLNK, "a symbolic link"),
+          (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def check_target(path, key: str) -> Path:
+    """Refuse, before any work, an output that could not be written or must not be replaced.
+
+    ``path`` must be a non-empty file name; if it exists it must be a regular file (a
+    directory, symbolic link, FIFO, device or socket there is refused: writing would replace
+    the node, not write into it); its folder must be a folder (or be creatable) and writable.
+    ``key`` names the setting in the message (``-o``, ``output.path``).
+    """
+    text = os.fspath(path) if not isinstance(path, str) else path
+    if not text or not text.strip():
+        raise OutputError(f"{key}: empty path; give a file name")
+    if "\0" in text:
+        raise OutputError(f"{key} = {text!r}: a path cannot hold a NUL character")
+    path = Path(text)
+    if text.endswith(("/", os.sep)):
+        raise OutputError(f"{key} = {text}: is a folder name, not a file name")
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        info = None
+    except OSError as exc:
+        raise OutputError(f"{key} = {text}: cannot be checked ({exc.strerror})") from None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        kind = next((name for test, name in _KINDS if test(info.st_mode)), "not a regular file")
+        raise OutputError(f"{key} = {text}: exists and is {kind}, not a regular file; "
+                          f"pulloff replaces only regular files: choose another path")
+    parent = _existing_parent(path)
+    if parent is None or not parent.is_dir():
+        raise OutputError(f"{key} = {text}: {parent if parent is not None else path.parent} "
+                          f"is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{key} = {text}: no permission to write in {parent}")
+    return path
+
+
+def _existing_parent(path: Path) -> Path | None:
+    """The nearest existing ancestor folder of ``path`` (the one a new file or folder is
+    made in), or a non-folder that stands in the way."""
+    parent = path.parent if str(path.parent) else Path(".")
+    while True:
+        if parent.exists() or parent.is_symlink():
+            return parent
+        if parent.parent == parent:
+            return None
+        parent = parent.parent
+
+
+def _temp_prefix(path: Path) -> str:
+    return f".{path.name}."
+
+
+def stale_temp_files(path) -> list[Path]:
+    """Temporary files an interrupted or killed writer of ``path`` left beside it."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    prefix = _temp_prefix(path)
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    # mkstemp's names: the prefix, 8 random characters, the suffix.
+    return [folder / n for n in names if n.startswith(prefix) and n.endswith(".tmp")
+            and len(n) == len(prefix) + 8 + len(".tmp")]
+
+
 @contextlib.contextmanager
-def atomic_file(path):
+def output_lock(path, key: str = "-o"):
+    """Hold the one-writer lock of the output ``path`` while the block runs.
+
+    The lock is a :class:`filelock.FileLock` on ``.NAME.lock`` beside the file (kept there
+    after release, as filelock recommends: removing a lock file races with the next writer);
+    the holder's pid, host and start time are written to ``.NAME.lock.holder`` while it holds
+    it. A second writer is refused at once with an :class:`OutputError` naming the file and
+    the holder. Under the lock, temporary files that a killed writer of the same output left
+    behind are removed.
+    """
+    from filelock import FileLock, Timeout
+
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    folder.mkdir(parents=True, exist_ok=True)
+    lock_path = folder / f".{path.name}.lock"
+    holder_path = folder / f".{path.name}.lock.holder"
+    lock = FileLock(str(lock_path), timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        raise OutputError(f"{key} = {path}: another pulloff process is writing it "
+                          f"({_read_holder(holder_path)}); wait for it to finish or choose "
+                          f"another path") from None
+    except OSError as exc:
+        raise OutputError(f"{key} = {path}: cannot lock it for writing ({exc.strerror or exc}; "
+                          f"lock file {lock_path})") from None
+    try:
+        _write_holder(holder_path)
+        for stale in stale_temp_files(path):
+            stale.unlink(missing_ok=True)
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            holder_path.unlink()
+        lock.release()
+
+
+def _write_holder(holder_path: Path) -> None:
+    text = (f"pid {os.getpid()} on host {socket.gethostname()} since "
+            f"{_dt.datetime.now().isoformat(timespec='seconds')}\n")
+    with contextlib.suppress(OSError):
+        holder_path.write_text(text, encoding="utf-8")
+
+
+def _read_holder(holder_path: Path) -> str:
+    try:
+        text = holder_path.read_text(encoding="utf-8").strip()
+    except OSError:
+        text = ""
+    return text or "holder unknown"
+
+
+@contextlib.contextmanager
+def atomic_file(path, key: str = "-o"):
     """Open an HDF5 file for writing that appears at ``path`` only once it is complete.
 
     The file is written under a temporary name in the same folder and renamed at the end; an
     exception or Ctrl-C leaves no file behind (and an older file at ``path`` untouched),
-    never a truncated one.
+    never a truncated one. A failure to write is an :class:`OutputError` naming ``path``
+    (``key`` says which setting gave it), not the temporary file.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(handle)
     try:
-        with h5py.File(tmp_name, "w") as f:
-            stamp(f)
-            yield f
-        # mkstemp creates 0600; a result file gets the permissions of any new file here.
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp_name, 0o666 & ~umask)
-        os.replace(tmp_name, path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, tmp_name = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=".tmp",
+                                            dir=path.parent)
+        os.close(handle)
+    except OSError as exc:
+        raise OutputError(f"{key} = {path}: cannot write ({exc.strerror or exc})") from None
+    try:
+        try:
+            with h5py.File(tmp_name, "w") as f:
+                stamp(f)
+                yield f
+            # mkstemp creates 0600; a result file gets the permissions of any new file here.
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp_name, 0o666 & ~umask)
+            os.replace(tmp_name, path)
+        except OSError as exc:
+            reason = (exc.strerror or str(exc)).replace(tmp_name, str(path))
+            raise OutputError(f"{key} = {path}: cannot write ({reason})") from None
     except BaseException:
         Path(tmp_name).unlink(missing_ok=True)
         raise
