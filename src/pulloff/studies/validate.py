@@ -1,7 +1,8 @@
 """``pulloff validate``: the seed's figures redrawn against the exact model, and a report.
 
-Runs its own sweeps (kept in ``OUT/data/*.h5`` and resumed, so a second call reuses them),
-then draws:
+Runs its own sweeps (kept in ``OUT/data/*.h5`` and resumed, so a second call reuses them;
+a call on other grids or another ``rtol`` recomputes only the scenes that differ), then
+draws:
 
 - ``alpha_tstar.png`` (the seed's Figs. 8 and 10): ``alpha`` against ``t* = t G / eta``. It shows
   eq. 53, its parabolic (eq. 56) and Taylor-2 (eq. 79) approximations, the exact model at
@@ -12,6 +13,9 @@ then draws:
 - ``error_map.png``: the seed closed form's error against the exact simulation over
   ``(alpha, chi)``, with the 7.34 % the seed claims drawn on it;
 - ``report.md``: the numbers behind the figures.
+
+The committed report lives in ``validation/``; ``--small`` writes to
+:data:`SMALL_OUTPUT` unless told otherwise, so a quick check never replaces it.
 """
 
 from __future__ import annotations
@@ -25,6 +29,11 @@ import numpy as np
 from ..io.scene_file import group_values, parse_scene, scene_from_groups
 from ..model import analytic
 from .sweeps import Axis, sweep, sweep_points
+
+#: Where a ``small`` validation goes unless an output folder is given.
+SMALL_OUTPUT = Path("runs") / "validation_small"
+#: Where the full validation goes (the committed report).
+FULL_OUTPUT = Path("validation")
 
 #: The seed's claimed worst error of its combined closed form (eq. 90).
 SEED_CLAIM = 0.0734
@@ -60,7 +69,9 @@ def run_sweeps(out: Path, rtol: float, small: bool, workers=None, progress=False
     data.mkdir(parents=True, exist_ok=True)
     base = scene_from_groups(1.0, 1e-3, rtol=rtol)
     keys = ["material.eta", "adhesion.delta", "model.history"]
-    common = {"workers": workers, "progress": progress}
+    # replace: a file of the same scene on another grid (--small before, or the other way
+    # round) keeps the rows of the points both grids share; the rest is computed.
+    common = {"workers": workers, "progress": progress, "replace": True}
 
     # Exact at every chi; frozen at the thinnest zone, where it must approach eq. 53.
     points, labels = _group_points(grid["curve_alpha"], grid["curve_chi"])
@@ -100,10 +111,14 @@ def _labelled(result, labels):
             "status": t["status"]}
 
 
-def validate(out_dir="validation", rtol: float = 1e-5, small: bool = False, workers=None,
+def validate(out_dir=None, rtol: float = 1e-5, small: bool = False, workers=None,
              progress: bool = False) -> Path:
-    """Run the sweeps, draw the figures and write ``report.md``; returns the report path."""
-    out = Path(out_dir)
+    """Run the sweeps, draw the figures and write ``report.md``; returns the report path.
+
+    ``out_dir`` defaults to :data:`FULL_OUTPUT`, or :data:`SMALL_OUTPUT` with ``small``.
+    """
+    out = Path(out_dir) if out_dir is not None else (SMALL_OUTPUT if small else FULL_OUTPUT)
+    check_outputs(out)
     start = time.perf_counter()
     sweeps = run_sweeps(out, rtol, small, workers, progress)
     elapsed = time.perf_counter() - start
@@ -121,8 +136,46 @@ def validate(out_dir="validation", rtol: float = 1e-5, small: bool = False, work
     plots.plot_force_speed(speeds, ELASTOMER, out / "force_speed.png")
     plots.plot_error_map(emap, sweeps["grid"], SEED_CLAIM, out / "error_map.png")
     report = out / "report.md"
-    report.write_text(render_report(numbers), encoding="utf-8")
+    _write_text(report, render_report(numbers))
     return report
+
+
+def _write_text(path: Path, text: str) -> None:
+    """Replace ``path`` whole or not at all (a temporary file beside it, renamed)."""
+    import os
+    import tempfile
+
+    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as f:
+            f.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+#: Files a validation writes in its folder.
+FIGURES = ("alpha_tstar.png", "taylor.png", "force_speed.png", "error_map.png")
+DATA = ("alpha_tstar.h5", "error_map.h5", "force_speed.h5")
+
+
+def check_outputs(out: Path) -> None:
+    """Refuse, before any work, a folder that is not one, or a file of the report that exists
+    and is not a regular file (see :func:`pulloff.io.h5.check_target`)."""
+    from ..io import h5 as h5io
+
+    if out.is_symlink() or (out.exists() and not out.is_dir()):
+        raise h5io.OutputError(f"-o = {out}: exists and is not a folder")
+    if (out / "data").is_symlink() or ((out / "data").exists() and not (out / "data").is_dir()):
+        raise h5io.OutputError(f"-o = {out}: {out / 'data'} exists and is not a folder")
+    for name in FIGURES + ("report.md",):
+        h5io.check_target(out / name, "-o")
+    for name in DATA:
+        h5io.check_target(out / "data" / name, "-o")
 
 
 def summarise(curves: dict, emap: dict, speeds) -> dict:
