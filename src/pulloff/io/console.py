@@ -130,13 +130,19 @@ def _short(value) -> str:
     return str(value)
 
 
-def format_sweep(result, max_rows: int = 40) -> str:
-    """One line per scene: the varied values, alpha/chi, the simulated force and the seed's."""
+def format_sweep(result, max_rows: int = 40, title: str | None = None) -> str:
+    """One line per scene: the varied values, alpha/chi, the simulated force and the seed's;
+    an interrupted sweep is marked INCOMPLETE with how many of its planned rows it holds."""
     table = result.table
     keys = [axis["key"] for axis in result.axes]
     n = table["index"].size
     failed = int(np.sum(table["status"] != "ok"))
-    lines = [f"sweep over {' x '.join(keys)}: {n} rows, {failed} failed"]
+    planned = getattr(result, "n_points", None)
+    lines = [title] if title else []
+    lines.append(f"sweep over {' x '.join(keys)}: {n} rows, {failed} failed")
+    if not getattr(result, "complete", True):
+        lines.append(f"  INCOMPLETE: {n} of {planned if planned is not None else '?'} planned "
+                     f"rows (interrupted; run the same sweep command to resume)")
     columns = keys + ["alpha", "chi", "F_contact [N]", "closed form", "estimate", "status"]
     widths = [max(12, len(c)) for c in columns]
     lines.append("  " + " ".join(f"{c:>{w}}" for c, w in zip(columns, widths)))
@@ -157,3 +163,54 @@ def format_sweep(result, max_rows: int = 40) -> str:
             line += f"  ({table['message'][r]})"
         lines.append(line)
     return "\n".join(lines)
+
+
+def scene_name(record: dict) -> str | None:
+    """The ``name`` of the scene stored in a run record (None if it has none)."""
+    from .scene_file import read_yaml
+
+    try:
+        data = read_yaml(str(record.get("scene", "")))
+    except ValueError:
+        return None
+    name = data.get("name") if isinstance(data, dict) else None
+    return str(name) if name is not None else None
+
+
+def _csv_value(value) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, (float, np.floating)):
+        return "" if math.isnan(value) else repr(float(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return str(value)
+
+
+def write_sweep_csv(result, stream) -> None:
+    """A sweep's table as CSV (header: column names with their units in brackets; empty
+    cells for nan), rows in grid order: for spreadsheets, pandas, R."""
+    import csv
+
+    column_unit = result.unit
+    names = result.columns()
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow([f"{n} [{column_unit(n)}]" if column_unit(n) not in ("", "1") else n
+                     for n in names])
+    columns = [result.table[n] for n in names]
+    for r in range(result.table["index"].size):
+        writer.writerow([_csv_value(column[r]) for column in columns])
+
+
+def write_history_csv(record: dict, stream) -> None:
+    """A run's history as CSV, one row per stored time, SI units in the header."""
+    import csv
+
+    from .h5 import HISTORY_UNITS
+
+    names = [n for n in HISTORY_UNITS if n in record["history"]]
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow([f"{n} [{HISTORY_UNITS[n]}]" for n in names])
+    columns = [record["history"][n] for n in names]
+    for r in range(len(columns[0]) if columns else 0):
+        writer.writerow([_csv_value(column[r]) for column in columns])
