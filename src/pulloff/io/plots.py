@@ -11,64 +11,142 @@ matplotlib.use("Agg")  # files only; a run on a headless machine must not need a
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+#: Closed forms drawn on the force panel: key of ``record["analytic"]``, label, colour, style.
+_CLOSED_FORMS = (
+    ("seed_closed_form_F", "seed closed form (eqs. 64/89)", "C2", ":"),
+    ("seed_linearised_F", "seed eq. 53 + 48", "C8", "-."),
+    ("kendall_F", "Kendall (eq. 95)", "C3", (0, (6, 2))),
+    ("elastic_F_contact", "elastic MDR-Dugdale F_contact", "C5", (0, (1, 1.5))),
+)
+
+
+def _finite(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and \
+        math.isfinite(value)
+
+
+def _legend(ax) -> None:
+    """A legend beside the panel, never over the curves or the closed-form lines."""
+    ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
+              frameon=False)
+
+
 def plot_history(record: dict, path, title: str | None = None) -> Path:
-    """Force, contact edge and zone end, and gap histories with the closed-form forces
-    marked; saves a PNG at ``path``."""
+    """Force (with the closed forms, the onset and the peak), cohesive-zone width
+    ``(b - a)/a`` with the contact edge, and gap histories; a driver/spring panel for a
+    compliant machine. Saves a PNG at ``path``."""
+    import numpy as np
+
     h = record["history"]
     s = record["summary"]
     an = record["analytic"]
-    t_ms = h["t"] * 1e3
-    fig, (ax_f, ax_r, ax_g) = plt.subplots(3, 1, figsize=(7.0, 8.4), sharex=True,
-                                           constrained_layout=True)
+    scene = _scene(record)
+    stiffness = _get(scene, "loading", "machine_stiffness")
+    t_ms = np.asarray(h["t"]) * 1e3
+    n_panels = 4 if _finite(stiffness) else 3
+    fig, axes = plt.subplots(n_panels, 1, figsize=(9.0, 2.6 * n_panels + 0.6), sharex=True,
+                             constrained_layout=True)
+    ax_f, ax_r, ax_g = axes[:3]
+
     ax_f.plot(t_ms, h["F_contact"], label="F_contact (simulation)", color="C0")
     ax_f.plot(t_ms, h["F_total"], label="F_total (simulation)", color="C1", ls="--")
-    for key, label, style in (("seed_closed_form_F", "seed closed form", ":"),
-                              ("seed_linearised_F", "seed eq. 53 + 48", "-."),
-                              ("kendall_F", "Kendall", (0, (1, 3)))):
+    scale = np.nanmax(np.abs(np.concatenate([np.asarray(h["F_contact"], float),
+                                             np.asarray(h["F_total"], float), [0.0]])))
+    for key, label, colour, style in _CLOSED_FORMS:
         value = an.get(key)
-        if isinstance(value, float) and math.isfinite(value):
-            ax_f.axhline(value, color="0.4", ls=style, lw=1.0, label=label)
-    if s["detached"]:
+        if not _finite(value):
+            continue
+        if scale > 0 and not 0.1 <= abs(value) / scale <= 10.0:
+            # Far off the simulated forces: a line there would only squash the curves.
+            ax_f.plot([], [], ls="none", label=f"{label}: {value:.3g} N (off scale)")
+            continue
+        # Dotted lines wider, so one lying on another closed form still shows.
+        ax_f.axhline(value, color=colour, ls=style, lw=2.0 if style == ":" or
+                     isinstance(style, tuple) and style[1][0] < 2 else 1.2,
+                     label=f"{label}: {value:.3g} N")
+    if s.get("detached"):
         ax_f.plot([s["t_detach"] * 1e3], [s["F_contact_detach"]], "ko", ms=4,
-                  label="detachment")
-    ax_f.set_ylabel("force [N]")
-    ax_f.legend(fontsize=8, loc="upper left")
-    ax_f.grid(alpha=0.3)
-
-    if "a" in h:
-        ax_r.plot(t_ms, h["a"] * 1e6, color="C3", label="contact edge a")
-    ax_r.plot(t_ms, h["b"] * 1e6, color="C4", ls="--", label="cohesive-zone end b")
-    if s.get("until") == "separation" and math.isfinite(s.get("F_peak_total", math.nan)):
+                  label="onset of detachment")
+    if s.get("until") == "separation" and _finite(s.get("F_peak_total", math.nan)):
         ax_f.plot([s["t_peak_total"] * 1e3], [s["F_peak_total"]], "kv", ms=5,
                   label="peak F_total")
-    ax_r.set_ylabel("radius [um]")
-    ax_r.legend(fontsize=8, loc="upper left")
-    ax_r.grid(alpha=0.3)
+    ax_f.set_ylabel("force [N]")
+    _legend(ax_f)
+    ax_f.grid(alpha=0.3)
 
-    ax_g.plot(t_ms, h["gap"] * 1e9, color="C2", label="gap at r = b")
-    delta = _delta(record)
-    if delta is not None:
-        ax_g.axhline(delta * 1e9, color="0.4", ls=":", lw=1.0, label="delta")
-    ax_g.set_xlabel("time [ms]")
+    # The zone width relative to the contact radius is the quantity that matters; a and b
+    # themselves differ in the sixth digit for a thin zone.
+    b = np.asarray(h["b"], dtype=float)
+    a = np.asarray(h["a"], dtype=float) if "a" in h else None
+    ref = a if a is not None else np.full_like(b, _get(scene, "geometry", "radius") or np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where((ref > 0) & (b > 0), (b - ref) / ref, np.nan)
+    ax_r.plot(t_ms, ratio, color="C4", label="(b - a)/a, cohesive-zone width")
+    positive = ratio[np.isfinite(ratio) & (ratio > 0)]
+    if positive.size > 1 and positive.max() / positive.min() > 100:
+        ax_r.set_yscale("log")
+    else:
+        ax_r.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3), useOffset=False)
+    ax_r.set_ylabel("(b - a)/a")
+    ax_r.grid(alpha=0.3)
+    handles, labels = ax_r.get_legend_handles_labels()
+    if a is not None:
+        ax_a = ax_r.twinx()
+        ax_a.plot(t_ms, a * 1e6, color="C3", lw=1.0, ls="--", label="contact edge a (right)")
+        ax_a.set_ylabel("a [um]")
+        ax_a.ticklabel_format(axis="y", useOffset=False, style="plain")
+        more_h, more_l = ax_a.get_legend_handles_labels()
+        handles, labels = handles + more_h, labels + more_l
+    ax_r.legend(handles, labels, fontsize=7.5, loc="upper left", bbox_to_anchor=(1.1, 1.0),
+                borderaxespad=0.0, frameon=False)
+
+    ax_g.plot(t_ms, np.asarray(h["gap"]) * 1e9, color="C2", label="gap at r = b")
+    delta = _get(scene, "adhesion", "delta")
+    if _finite(delta):
+        ax_g.axhline(delta * 1e9, color="0.4", ls=":", lw=1.0, label="delta (onset)")
     ax_g.set_ylabel("gap [nm]")
-    ax_g.legend(fontsize=8, loc="upper left")
+    _legend(ax_g)
     ax_g.grid(alpha=0.3)
+
+    if n_panels == 4:
+        ax_m = axes[3]
+        lift = np.asarray(h["h"], dtype=float)
+        v = _get(scene, "loading", "v")
+        if _get(scene, "loading", "kind") == "constant_velocity" and _finite(v):
+            driver = (_get(scene, "loading", "h0") or 0.0) + v * np.asarray(h["t"])
+            driver_label = "driver h0 + v t"
+        else:
+            driver = lift + np.asarray(h["F_total"], dtype=float) / stiffness
+            driver_label = "driver (h + F_total / k)"
+        ax_m.plot(t_ms, driver * 1e6, color="0.3", label=driver_label)
+        ax_m.plot(t_ms, lift * 1e6, color="C0", ls="--", label="punch lift h")
+        ax_m.fill_between(t_ms, lift * 1e6, driver * 1e6, color="C0", alpha=0.12,
+                          label=f"spring stretch (k = {stiffness:.3g} N/m)")
+        ax_m.set_ylabel("machine [um]")
+        _legend(ax_m)
+        ax_m.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [ms]")
     if title:
         fig.suptitle(title, fontsize=10)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
-def _delta(record) -> float | None:
-    import yaml
+def _scene(record) -> dict:
+    """The stored scene as plain data ({} where it cannot be read)."""
+    from .scene_file import read_yaml
 
     try:
-        return float(yaml.safe_load(record["scene"])["adhesion"]["delta"])
-    except Exception:  # the figure is still useful without the reference line
-        return None
+        data = read_yaml(str(record.get("scene", "")))
+    except Exception:  # the figure is still useful without the scene's reference lines
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _get(scene: dict, section: str, key: str):
+    part = scene.get(section)
+    value = part.get(key) if isinstance(part, dict) else None
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) \
+        else value
 
 
 # --- validation figures ---------------------------------------------------------------------
@@ -155,6 +233,12 @@ def plot_force_speed(speeds, material: dict, path) -> Path:
     ax.axhline(analytic.kendall_force(e["G"], e["sigma_c"] * e["delta"], e["a"]), color="C3",
                lw=1.0, ls="-.", label="Kendall (eq. 95)")
     ax.axhline(elastic["F_total"], color="C2", lw=0.8, ls=":", label="elastic MDR F_total")
+    # The range of the simulated forces: the viscous line would otherwise spend decades on
+    # speeds where it is far below them and squeeze the transition.
+    simulated = np.concatenate([t["F_contact_detach"], t["F_total_detach"]])
+    simulated = simulated[np.isfinite(simulated) & (simulated > 0)]
+    if simulated.size:
+        ax.set_ylim(simulated.min() / 2.0, simulated.max() * 2.0)
     ax.set_xlabel("pull speed v [m/s]")
     ax.set_ylabel("pull-off force [N]")
     ax.set_title(f"G = {e['G']:.2g} Pa, eta = {e['eta']:.2g} Pa s, sigma_c = "
@@ -194,10 +278,30 @@ def plot_error_map(emap: dict, grid: dict, claim: float, path) -> Path:
 
 
 def _save(fig, path) -> Path:
+    """Save a figure atomically: written beside ``path`` under a temporary name and renamed,
+    so an existing figure is replaced whole or not at all."""
+    import os
+    import tempfile
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    fmt = path.suffix[1:].lower() or "png"
+    try:
+        if fmt not in fig.canvas.get_supported_filetypes():
+            raise ValueError(f"{path}: cannot draw a .{fmt} figure (use .png, .pdf or .svg)")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(handle)
+        try:
+            fig.savefig(tmp, dpi=120, format=fmt)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    finally:
+        plt.close(fig)
     return path
 
 
