@@ -321,7 +321,10 @@ def _install_signal_handlers() -> None:
 def main(argv=None) -> int:
     from .model.scene import SceneError
 
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # a usage error (status 2, one line printed), --help, --version
+        return exc.code if isinstance(exc.code, int) else 2
     _STOPPED_BY["signal"] = signal.SIGINT
     previous = {name: signal.getsignal(getattr(signal, name)) for name in ("SIGTERM", "SIGHUP")
                 if hasattr(signal, name)}
