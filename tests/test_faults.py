@@ -541,3 +541,19 @@ def test_titles_are_the_scene_name(tmp_path, capsys, monkeypatch):
 def test_multi_problem_scenes_are_one_line(tmp_path, capsys):
     assert main(["run", str(SEED), "--set", "material.G=-1", "--set", "loading.v=0"]) == 2
     _one_error_line(capsys.readouterr().err, "run", "material.G", "loading.v")
+
+
+def test_an_order_and_a_percentage_only_where_they_mean_something():
+    from pulloff.io.console import format_table
+
+    summary = dict(alpha=1.0, chi=1.0, V=1.0, detached=True, t_detach=1.0, h_detach=1.0,
+                   b_detach=1.0, zone_ratio_detach=0.1, F_contact_detach=1.0,
+                   F_total_detach=1.0, error_estimate=1e-3, until="separation", t_end=1.0,
+                   n_elements=1, n_steps=1, wall_time=0.1, F_peak_total=2.0, t_peak_total=1.0,
+                   F_peak_contact=1.0, t_peak_contact=1.0, t_separation=2.0)
+    record = {"analytic": {"seed_closed_form_F": 12442139.0, "kendall_F": 1.05},
+              "history": {"t": np.zeros(3)}}
+    for order, shown in ((-0.677, "none: levels not converging"), (1.93, "1.93")):
+        text = format_table(dict(record, summary=dict(summary, observed_order=order)))
+        assert shown in text and "-0.677" not in text
+    assert "+5.00%" in text and "x1.24e+07" in text and "%" not in text.split("x1.24e+07")[0][-20:]

@@ -110,9 +110,10 @@ def format_table(record: dict, title: str | None = None) -> str:
             ("peak / onset F_total", _rel(s.get("F_peak_total"), F_on)),
         ]
         order = s.get("observed_order")
-        if isinstance(order, float) and math.isfinite(order) and order >= 0.5:
-            # Only where the last three levels converge; elsewhere a number would mislead.
-            rows.append(("observed order (step)", _fmt(order)))
+        if isinstance(order, float) and math.isfinite(order):
+            # A number only where the last three levels converge; elsewhere it would mislead.
+            rows.append(("observed order (step)", _fmt(order) if order >= 0.5 else
+                         "none: levels not converging"))
         for label, text in rows:
             lines.append(f"    {label:<28} {text:>30}")
     for note in filter(None, str(s.get("notes", "")).split("; ")):
