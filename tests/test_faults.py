@@ -557,3 +557,71 @@ def test_an_order_and_a_percentage_only_where_they_mean_something():
         text = format_table(dict(record, summary=dict(summary, observed_order=order)))
         assert shown in text and "-0.677" not in text
     assert "+5.00%" in text and "x1.24e+07" in text and "%" not in text.split("x1.24e+07")[0][-20:]
+
+
+# --- figures ----------------------------------------------------------------------------------
+
+def _record(machine=None):
+    t = np.linspace(0.0, 1e-2, 50)
+    history = {"t": t, "h": 1e-3 * t, "a": np.full_like(t, 1e-3),
+               "b": 1e-3 * (1 + 3e-6 * (1 + t / 1e-2)), "gap": 1e-8 * (t / 1e-2) ** 2,
+               "F_contact": 0.02 + 3.0 * t, "F_total": 0.02 + 3.1 * t}
+    scene = ("schema: 1\nname: fig\ngeometry: {kind: flat_punch, radius: 0.001}\n"
+             "adhesion: {kind: dugdale, sigma_c: 5.0e6, delta: 1.0e-8}\n"
+             f"loading: {{kind: constant_velocity, v: 0.001, h0: 0.0, "
+             f"machine_stiffness: {machine if machine else 'null'}}}\n")
+    summary = {"detached": True, "t_detach": 1e-2, "F_contact_detach": 0.05,
+               "until": "separation", "F_peak_total": 0.051, "t_peak_total": 1e-2}
+    analytic = {"seed_closed_form_F": 0.0599, "seed_linearised_F": 0.0598, "kendall_F": 0.0388,
+                "elastic_F_contact": 0.0388, "viscous_F": 1e-9}
+    return {"history": history, "summary": summary, "analytic": analytic, "scene": scene}
+
+
+def _drawn(monkeypatch):
+    from pulloff.io import plots
+
+    figures = []
+    monkeypatch.setattr(plots, "_save", lambda fig, path: figures.append(fig) or Path(path))
+    return plots, figures
+
+
+def test_run_figure_reads_as_a_scientist_needs(monkeypatch):
+    plots, figures = _drawn(monkeypatch)
+    plots.plot_history(_record(), "x.png", title="fig")
+    ax_f, ax_r = figures[0].axes[:2]
+    labels = [t.get_text() for t in ax_f.get_legend().get_texts()]
+    for wanted in ("seed closed form", "Kendall", "elastic MDR-Dugdale F_contact",
+                   "onset of detachment", "peak F_total"):
+        assert any(label.startswith(wanted) for label in labels), (wanted, labels)
+    styles = [(line.get_color(), str(line.get_linestyle()), line.get_dashes() if hasattr(
+        line, "get_dashes") else None) for line in ax_f.get_lines()[2:6]]
+    assert len({(c, s) for c, s, _ in styles}) == 4  # every closed form its own look
+    # The legend sits beside the panel, not over the lines.
+    bbox = ax_f.get_legend().get_bbox_to_anchor().transformed(ax_f.transAxes.inverted())
+    assert bbox.x0 >= 1.0
+    assert ax_r.get_ylabel() == "(b - a)/a"
+    assert ax_r.yaxis.get_major_formatter().get_useOffset() is False
+    assert len(figures[0].axes) == 4  # force, zone (+ its twin for a), gap: no machine panel
+
+
+def test_a_compliant_machine_gets_a_driver_and_spring_panel(monkeypatch):
+    plots, figures = _drawn(monkeypatch)
+    plots.plot_history(_record(machine=100.0), "x.png")
+    last = figures[0].axes[3]  # the fourth panel (the twin axis of a comes after)
+    labels = [t.get_text() for t in last.get_legend().get_texts()]
+    assert labels[0] == "driver h0 + v t" and "punch lift h" in labels
+    assert any("spring" in label for label in labels)
+
+
+def test_force_speed_spends_its_range_on_the_simulated_forces(monkeypatch):
+    from types import SimpleNamespace
+
+    plots, figures = _drawn(monkeypatch)
+    v = np.logspace(-9, 1, 6)
+    F = np.array([0.05, 0.05, 0.05, 0.06, 4.0, 400.0])
+    table = {"loading.v": v, "F_contact_detach": F, "F_total_detach": 1.1 * F,
+             "seed_closed_form_F": F}
+    material = {"G": 0.5e6, "eta": 5e3, "sigma_c": 1e6, "delta": 5e-8, "a": 1e-3}
+    plots.plot_force_speed(SimpleNamespace(table=table), material, "x.png")
+    low, high = figures[0].axes[0].get_ylim()
+    assert low >= 0.05 / 3 and high <= 440 * 3
