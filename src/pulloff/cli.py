@@ -58,9 +58,15 @@ def _cmd_run(args) -> int:
         if png is None:
             print(f"  wrote {out}")
         else:
-            from .io import plots
+            try:
+                from .io import plots
 
-            plots.plot_history(record, png, title=title)
+                plots.plot_history(record, png, title=title)
+            except KeyboardInterrupt:
+                print(f"  wrote {out}")
+                print(f"pulloff run: {_stop_name()} while drawing {png}: {out} is written "
+                      f"(complete = {result.complete}); no figure", file=sys.stderr)
+                return _stop_status()
             print(f"  wrote {out} and {png}")
     if not result.complete:
         print(f"pulloff run: {_stop_name()}: {out} holds the history computed so far and is "
