@@ -102,33 +102,47 @@ def load_at(p0, p1, p2, xi, s):
 
 
 @njit(cache=True)
-def path_roots(p0, p1, p2, xi, lo, hi, roots):
-    """Real roots of ``B(s) = xi`` in ``(lo, hi)``, ascending, into ``roots``; returns how many."""
+def path_roots2(p0, p1, p2, xi, lo, hi):
+    """``(count, r1, r2)``: the real roots of ``B(s) = xi`` in ``(lo, hi)``, ascending."""
     c = p0 - xi
-    n = 0
+    r1 = r2 = math.nan
     if abs(p2) < 1e-14 * (abs(p1) + abs(c) + 1e-300):
         if p1 != 0.0:
             r = -c / p1
             if lo < r < hi:
-                roots[0] = r
-                n = 1
-        return n
+                return 1, r, math.nan
+        return 0, r1, r2
     disc = p1 * p1 - 4.0 * p2 * c
     if disc < 0.0:
-        return 0
+        return 0, r1, r2
     sq = math.sqrt(disc)
     # Citardauq: no cancellation in either root.
     q = -0.5 * (p1 + (sq if p1 >= 0.0 else -sq))
-    r1 = q / p2
-    r2 = c / q if q != 0.0 else r1
-    if r1 > r2:
-        r1, r2 = r2, r1
-    if lo < r1 < hi:
-        roots[n] = r1
+    a = q / p2
+    b = c / q if q != 0.0 else a
+    if a > b:
+        a, b = b, a
+    n = 0
+    if lo < a < hi:
+        r1 = a
+        n = 1
+    if lo < b < hi and b != a:
+        if n == 0:
+            r1 = b
+        else:
+            r2 = b
         n += 1
-    if lo < r2 < hi and r2 != r1:
-        roots[n] = r2
-        n += 1
+    return n, r1, r2
+
+
+@njit(cache=True)
+def path_roots(p0, p1, p2, xi, lo, hi, roots):
+    """Real roots of ``B(s) = xi`` in ``(lo, hi)``, ascending, into ``roots``; returns how many."""
+    n, r1, r2 = path_roots2(p0, p1, p2, xi, lo, hi)
+    if n > 0:
+        roots[0] = r1
+    if n > 1:
+        roots[1] = r2
     return n
 
 
@@ -200,6 +214,35 @@ def _graded_around(p0, p1, p2, xi, a, b, centre, width, mus, nm, mu_max, s1, out
 
 
 @njit(cache=True)
+def _loaded_piece(p0, p1, p2, xi, a, b, n, r1, r2, reach, mus, nm, mu_max, s1, out):
+    """One piece ``[a, b]`` between roots: skipped where the zone does not reach, else
+    integrated with the square-root substitution from whichever root is near."""
+    if b <= a or path_value(p0, p1, p2, 0.5 * (a + b)) <= xi:
+        return
+    root_lo = -math.inf
+    root_hi = math.inf
+    for j in range(n):
+        r = r1 if j == 0 else r2
+        if r <= a + 1e-15:
+            root_lo = r
+        elif r >= b - 1e-15 and root_hi == math.inf:
+            root_hi = r
+    near_lo = a - root_lo <= reach
+    near_hi = root_hi - b <= reach
+    if near_lo and near_hi:
+        # An entry and an exit: each half substitutes from its own root.
+        mid = 0.5 * (a + b)
+        _piece(p0, p1, p2, xi, a, mid, root_lo, 1, mus, nm, mu_max, s1, out)
+        _piece(p0, p1, p2, xi, mid, b, root_hi, -1, mus, nm, mu_max, s1, out)
+    elif near_lo:
+        _piece(p0, p1, p2, xi, a, b, root_lo, 1, mus, nm, mu_max, s1, out)
+    elif near_hi:
+        _piece(p0, p1, p2, xi, a, b, root_hi, -1, mus, nm, mu_max, s1, out)
+    else:
+        _piece(p0, p1, p2, xi, a, b, 0.0, 0, mus, nm, mu_max, s1, out)
+
+
+@njit(cache=True)
 def load_integrals(p0, p1, p2, xi, s0, s1, mus, nm, w3, out):
     """``out[k] = int_{s0}^{s1} e^{-mu_k (s1-s)} Q(s) ds`` for one element (the whole step
     ``[0, 1]``, or part of it for an element the contact edge releases or captures inside the
@@ -211,8 +254,7 @@ def load_integrals(p0, p1, p2, xi, s0, s1, mus, nm, w3, out):
     for k in range(nm):
         mu_max = max(mu_max, mus[k])
     reach = young_reach(mu_max)
-    roots = np.empty(2)
-    n = path_roots(p0, p1, p2, xi, s0 - reach, s1 + reach, roots)
+    n, r1, r2 = path_roots2(p0, p1, p2, xi, s0 - reach, s1 + reach)
     if n == 0 and p2 != 0.0:
         # B - xi may touch zero only nearly (a turning point of the zone end just beyond the
         # element): the load is then steep around the vertex; panels graded toward it.
@@ -229,43 +271,17 @@ def load_integrals(p0, p1, p2, xi, s0, s1, mus, nm, w3, out):
                 q = load_at(p0, p1, p2, xi, RADAU3[i])
                 for k in range(nm):
                     out[k] += w3[k, i] * q
-        return load_at(p0, p1, p2, xi, 1.0)
-    # Pieces of [s0, 1] between roots; the load's sign is that of B - xi at their middle.
-    cuts = np.empty(4)
-    nc = 0
-    cuts[nc] = s0
-    nc += 1
-    for j in range(n):
-        if s0 < roots[j] < s1:
-            cuts[nc] = roots[j]
-            nc += 1
-    cuts[nc] = s1
-    nc += 1
-    for j in range(nc - 1):
-        a = cuts[j]
-        b = cuts[j + 1]
-        if b <= a or path_value(p0, p1, p2, 0.5 * (a + b)) <= xi:
+        return load_at(p0, p1, p2, xi, s1)
+    # Pieces of [s0, s1] between the roots inside it.
+    c1 = r1 if (n > 0 and s0 < r1 < s1) else math.nan
+    c2 = r2 if (n > 1 and s0 < r2 < s1) else math.nan
+    a = s0
+    for j in range(3):
+        cut = c1 if j == 0 else (c2 if j == 1 else s1)
+        if math.isnan(cut):
             continue
-        root_lo = -math.inf
-        root_hi = math.inf
-        for r in range(n):
-            if roots[r] <= a + 1e-15:
-                root_lo = roots[r]
-            elif roots[r] >= b - 1e-15 and root_hi == math.inf:
-                root_hi = roots[r]
-        near_lo = a - root_lo <= reach
-        near_hi = root_hi - b <= reach
-        if near_lo and near_hi:
-            # An entry and an exit: each half substitutes from its own root.
-            mid = 0.5 * (a + b)
-            _piece(p0, p1, p2, xi, a, mid, root_lo, 1, mus, nm, mu_max, s1, out)
-            _piece(p0, p1, p2, xi, mid, b, root_hi, -1, mus, nm, mu_max, s1, out)
-        elif near_lo:
-            _piece(p0, p1, p2, xi, a, b, root_lo, 1, mus, nm, mu_max, s1, out)
-        elif near_hi:
-            _piece(p0, p1, p2, xi, a, b, root_hi, -1, mus, nm, mu_max, s1, out)
-        else:
-            _piece(p0, p1, p2, xi, a, b, 0.0, 0, mus, nm, mu_max, s1, out)
+        _loaded_piece(p0, p1, p2, xi, a, cut, n, r1, r2, reach, mus, nm, mu_max, s1, out)
+        a = cut
     return load_at(p0, p1, p2, xi, s1)
 
 
@@ -283,26 +299,24 @@ def advance_free(Y, i, integrals, decay, zdt, ctil, d, q_end, nm):
 # --- gap integral ------------------------------------------------------------------------------
 
 @njit(cache=True)
+def _basis_integral(tj, r0, r1, r2, a, b):
+    """``int_a^b prod_m (t - r_m) / (tj - r_m) dt`` over the three other nodes ``r``."""
+    den = (tj - r0) * (tj - r1) * (tj - r2)
+    e1 = r0 + r1 + r2
+    e2 = r0 * r1 + r0 * r2 + r1 * r2
+    e3 = r0 * r1 * r2
+    ib = ((b ** 4 - a ** 4) / 4.0 - e1 * (b ** 3 - a ** 3) / 3.0
+          + e2 * (b * b - a * a) / 2.0 - e3 * (b - a))
+    return ib / den
+
+
+@njit(cache=True)
 def _cubic_weights(t0, t1, t2, t3, a, b, w):
     """``w[j] = int_a^b l_j(t) dt`` for the Lagrange cubic through ``t0..t3``."""
-    ts = (t0, t1, t2, t3)
-    for j in range(4):
-        # Coefficients of prod_{m != j} (t - t_m) / (t_j - t_m), integrated exactly.
-        den = 1.0
-        roots = np.empty(3)
-        r = 0
-        for m in range(4):
-            if m != j:
-                den *= ts[j] - ts[m]
-                roots[r] = ts[m]
-                r += 1
-        e1 = roots[0] + roots[1] + roots[2]
-        e2 = roots[0] * roots[1] + roots[0] * roots[2] + roots[1] * roots[2]
-        e3 = roots[0] * roots[1] * roots[2]
-        # t^3 - e1 t^2 + e2 t - e3, integrated in shifted form for accuracy.
-        ib = ((b ** 4 - a ** 4) / 4.0 - e1 * (b ** 3 - a ** 3) / 3.0
-              + e2 * (b * b - a * a) / 2.0 - e3 * (b - a))
-        w[j] = ib / den
+    w[0] = _basis_integral(t0, t1, t2, t3, a, b)
+    w[1] = _basis_integral(t1, t0, t2, t3, a, b)
+    w[2] = _basis_integral(t2, t0, t1, t3, a, b)
+    w[3] = _basis_integral(t3, t0, t1, t2, a, b)
 
 
 @njit(cache=True)
@@ -455,3 +469,285 @@ def interpolate_cubic(xs, fs, x):
                 lj *= (x - xs[k]) / (xs[j] - xs[k])
         out += lj * fs[j]
     return out
+
+
+# --- one trial step, compiled ------------------------------------------------------------------
+#: Indices of the scalar results of :func:`evaluate_step`.
+R_GAP, R_EDGE_LOAD, R_EDGE_FREE_U, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(7)
+#: Indices of the step constants ``sc`` of :func:`evaluate_step`.
+(S_T0, S_DT, S_ALPHA0, S_BETA0, S_H1, S_HDOT, S_XIMAX, S_KAPPA, S_C, S_D, S_FLAT, S_AF, S_C_G,
+ S_N_G, S_K_ALPHA, S_K_BETA, S_JUMP) = range(17)
+
+
+@njit(cache=True)
+def path_root(p0, p1, p2, x):
+    """The fraction of the step where the path passes ``x`` (clamped to the step)."""
+    roots = np.empty(2)
+    n = path_roots(p0, p1, p2, x, -1e-12, 1.0 + 1e-12, roots)
+    if n == 0:
+        return 1.0 if abs(path_value(p0, p1, p2, 1.0) - x) < abs(p0 - x) else 0.0
+    return min(max(roots[0], 0.0), 1.0)
+
+
+@njit(cache=True)
+def _profile(sc, x):
+    """``g(x)`` of a power-law profile (0 for a flat punch)."""
+    if sc[S_C_G] == 0.0:
+        return 0.0
+    return sc[S_C_G] * abs(x) ** sc[S_N_G]
+
+
+@njit(cache=True)
+def _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, x, out):
+    """``D_i e^{-(t - tj)/tau_i}`` of a contact element at ``x``, linear between the contact
+    elements (0 with none); returns ``sum_i kappa_i`` of it."""
+    na = tau_arms.size
+    for i in range(na):
+        out[i] = 0.0
+    left, right = -1, -1
+    for j in range(n_all):
+        if status[j] != 1:
+            continue
+        if xi[j] <= x:
+            left = j
+        elif right < 0:
+            right = j
+    if left < 0 and right < 0:
+        return 0.0
+    total = 0.0
+    for i in range(na):
+        vl = D[left, i] * math.exp(-(t - tj[left]) / tau_arms[i]) if left >= 0 else 0.0
+        vr = D[right, i] * math.exp(-(t - tj[right]) / tau_arms[i]) if right >= 0 else 0.0
+        if left >= 0 and right >= 0 and xi[right] > xi[left]:
+            w = (x - xi[left]) / (xi[right] - xi[left])
+            out[i] = (1.0 - w) * vl + w * vr
+        else:
+            out[i] = vl if left >= 0 else vr
+        total += kappa_arms[i] * out[i]
+    return total
+
+
+@njit(cache=True)
+def _filtered_lift(Hf0, arm_mus, hp, s, out):
+    """The arms' filtered lift ``Hf`` at fraction ``s`` of the step (``hp`` the lift path)."""
+    for i in range(Hf0.size):
+        mu = arm_mus[i] * s
+        m0, m1, m2 = exp_moments(mu)
+        out[i] = (math.exp(-mu) * Hf0[i]
+                  + mu * (hp[0] * m0 + hp[1] * s * m1 + hp[2] * s * s * m2))
+
+
+@njit(cache=True)
+def _contact_modes(x, s_c, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj, n_all,
+                   kappa_arms, tau_arms, nm, out):
+    """Modes of a contact element at ``x`` released at fraction ``s_c``."""
+    G = _profile(sc, x)
+    if tau_arms.size == 0:
+        if nm > 0:
+            out[0] = path_value(hp[0], hp[1], hp[2], s_c) + G
+        return
+    na = tau_arms.size
+    Hf = np.empty(na)
+    _filtered_lift(Hf0, arm_mus, hp, s_c, Hf)
+    mem = np.empty(na)
+    _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, sc[S_T0] + s_c * sc[S_DT], x, mem)
+    for k in range(nm):
+        acc = 0.0
+        for i in range(na):
+            acc += V_inv[k, i] * (Hf[i] + G + mem[i])
+        out[k] = acc
+
+
+@njit(cache=True)
+def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, out):
+    """The elements a trial step advances, in ascending ``x``: new ones where a receding flat
+    punch releases the solid, the existing ones ``lo..hi-1``, new ones where the zone end
+    enters virgin solid. Each is advanced from where its free stretch starts; returns the
+    count. ``flag``: 0 an existing element, 1 a new one, 2 one that stays in contact."""
+    xi, Y, status, D, tj, t_last = mesh
+    ctil, kappa_arms, tau_arms, V_inv = law
+    mus, decay, zdt, w3, arm_mus, Hf0, Hf1 = stepw
+    xo, Yo, Uo, fo = out
+    nm = mus.size
+    ap, bp, hp = paths[0], paths[1], paths[2]
+    alpha0 = sc[S_ALPHA0]
+    k_a = int(sc[S_K_ALPHA]) if (sc[S_FLAT] > 0.0 and alpha1 < alpha0) else 0
+    start = max(sc[S_BETA0], sc[S_XIMAX], 0.0)
+    k_b = int(sc[S_K_BETA]) if beta1 > start else 0
+    theta_b = math.acos(min(start / beta1, 1.0)) if k_b > 0 else 0.0
+    m = 0
+    y0 = np.zeros(max(nm, 1))
+    ints = np.empty(max(nm, 1))
+    for j in range(k_a + (hi - lo) + k_b):
+        s0 = 0.0
+        for k in range(nm):
+            y0[k] = 0.0
+        if j < k_a:  # released by the receding rim, in ascending order
+            x = alpha0 + (alpha1 - alpha0) * (k_a - j) / k_a
+            s0 = path_root(ap[0], ap[1], ap[2], x)
+            _contact_modes(x, s0, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj, n_all,
+                           kappa_arms, tau_arms, nm, y0)
+            flag = 1
+        elif j < k_a + hi - lo:
+            i = lo + j - k_a
+            x = xi[i]
+            flag = 0
+            if status[i] == 1 and x <= alpha1:
+                xo[m] = x
+                Uo[m] = hp[0] + hp[1] + hp[2] + _profile(sc, x)
+                fo[m] = 2
+                for k in range(nm):
+                    Yo[m, k] = Y[i, k]
+                m += 1
+                continue
+            if status[i] == 1:  # released by the receding edge inside the step
+                s0 = path_root(ap[0], ap[1], ap[2], x)
+                _contact_modes(x, s0, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj,
+                               n_all, kappa_arms, tau_arms, nm, y0)
+            else:
+                lag = (sc[S_T0] - t_last[i]) / sc[S_DT]
+                for k in range(nm):
+                    y0[k] = Y[i, k] * (math.exp(-mus[k] * lag) if lag > 0.0 else 1.0)
+        else:  # entering virgin solid, evenly in angle toward the zone end
+            jj = j - k_a - (hi - lo) + 1
+            x = beta1 * math.cos(theta_b * (k_b - jj) / k_b)
+            flag = 1
+        q1 = load_integrals(bp[0], bp[1], bp[2], x, s0, 1.0, mus, nm, w3, ints)
+        u = sc[S_D] * q1
+        for k in range(nm):
+            y = math.exp(-mus[k] * (1.0 - s0)) * y0[k] + zdt[k] * ints[k]
+            Yo[m, k] = y
+            u += ctil[k] * y
+        xo[m] = x
+        Uo[m] = u
+        fo[m] = flag
+        m += 1
+    return m
+
+
+@njit(cache=True)
+def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, res):
+    """The free part of the gap integral and a free element's displacement at the edge."""
+    H1 = sc[S_H1]
+    centre = math.nan
+    n_in = 0
+    for j in range(m):
+        if xo[j] == 0.0 and fo[j] != 2:
+            centre = Uo[j]
+        if fo[j] != 2 and alpha1 < xo[j] < beta1:
+            n_in += 1
+    res[R_CENTRE_U] = centre
+    if beta1 <= 0.0:
+        res[R_GAP] = H1 - centre
+        return 0.0
+    xs = np.empty(n_in)
+    us = np.empty(n_in)
+    c = 0
+    for j in range(m):
+        if fo[j] != 2 and alpha1 < xo[j] < beta1:
+            xs[c] = xo[j]
+            us[c] = Uo[j]
+            c += 1
+    virgin = beta1 > sc[S_XIMAX] * (1.0 + 1e-12) and beta1 > sc[S_BETA0]
+    U_beta = 0.0 if virgin else math.nan
+    U_alpha = H1 + _profile(sc, alpha1) if alpha1 > 0.0 else centre
+    integral = free_gap_integral(xs, us, 0, n_in, alpha1, beta1, U_alpha, U_beta)
+    # A free element at the edge: the cubic in angle through the four nearest free ones.
+    target = angle(alpha1, beta1) if alpha1 > 0.0 else 0.5 * math.pi
+    ths = np.empty(4)
+    fs = np.empty(4)
+    count = 0
+    used = np.zeros(m, dtype=np.bool_)
+    for _ in range(4):
+        best, best_d = -1, math.inf
+        for j in range(m):
+            if used[j] or fo[j] == 2 or xo[j] >= beta1:
+                continue
+            d = abs(angle(xo[j], beta1) - target)
+            if d < best_d:
+                best, best_d = j, d
+        if best < 0:
+            break
+        used[best] = True
+        th = angle(xo[best], beta1)
+        duplicate = False
+        for k in range(count):
+            if ths[k] == th:
+                duplicate = True
+        if not duplicate:
+            ths[count] = th
+            fs[count] = Uo[best]
+            count += 1
+    res[R_EDGE_FREE_U] = (interpolate_cubic(ths[:count].copy(), fs[:count].copy(), target)
+                          if count >= 2 else math.nan)
+    return integral
+
+
+@njit(cache=True)
+def evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, out, res):
+    """One trial step's end for trial edges ``alpha1``, ``beta1`` (and the lift in ``sc``):
+    every element advanced (:func:`_gather`), then into ``res`` the gap at ``b``, the line
+    load of the contact element at ``a``, a free element's displacement there, the forces
+    and the centre's displacement. Returns the element count written to ``out``."""
+    xi, Y, status, D, tj, t_last = mesh
+    ctil, kappa_arms, tau_arms, V_inv = law
+    mus, decay, zdt, w3, arm_mus, Hf0, Hf1 = stepw
+    xo, Yo, Uo, fo = out
+    m = _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, out)
+    integral = _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, res)
+    if beta1 <= 0.0:
+        res[R_EDGE_LOAD] = math.nan
+        res[R_F_CONTACT] = 0.0
+        res[R_F_TOTAL] = 0.0
+        return m
+    H1 = sc[S_H1]
+    ell = math.sqrt(max((beta1 - alpha1) * (beta1 + alpha1), 0.0))
+    theta_a = math.atan2(ell, alpha1)
+    contact = profile_integral(sc[S_C_G], sc[S_N_G], alpha1, beta1)
+    f_beta = sc[S_AF] * beta1 ** sc[S_N_G] if sc[S_AF] != 0.0 else 0.0
+    res[R_GAP] = (2.0 / math.pi) * H1 * theta_a + f_beta - (2.0 / math.pi) * (contact + integral)
+    # The contact side: its line load at the edge and its force.
+    t1 = sc[S_T0] + sc[S_DT]
+    G = _profile(sc, alpha1)
+    g_int = (sc[S_C_G] * alpha1 ** (sc[S_N_G] + 1.0) / (sc[S_N_G] + 1.0)
+             if sc[S_C_G] != 0.0 else 0.0)
+    kappa, c = sc[S_KAPPA], sc[S_C]
+    load = kappa * (H1 + G) + c * sc[S_HDOT]
+    force = kappa * (H1 * alpha1 + g_int) + c * sc[S_HDOT] * alpha1
+    na = tau_arms.size
+    if na > 0 and alpha1 > 0.0:
+        mem = np.empty(na)
+        load -= _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1, alpha1, mem)
+        for i in range(na):
+            load += kappa_arms[i] * (H1 - Hf1[i])
+            force += alpha1 * kappa_arms[i] * (H1 - Hf1[i])
+        force -= _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1, alpha1)
+    res[R_EDGE_LOAD] = load if alpha1 > 0.0 else 0.0
+    res[R_F_CONTACT] = 4.0 * force if alpha1 > 0.0 else 0.0
+    res[R_F_TOTAL] = res[R_F_CONTACT] + 2.0 * (beta1 * beta1 * theta_a - alpha1 * ell)
+    return m
+
+
+@njit(cache=True)
+def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha):
+    """``int_0^alpha`` of the arms' contact memory (trapezoid over the contact elements)."""
+    total = 0.0
+    x_prev, v_prev = 0.0, math.nan
+    mem = np.empty(tau_arms.size)
+    for j in range(n_all):
+        if status[j] != 1 or xi[j] >= alpha:
+            continue
+        v = 0.0
+        for i in range(tau_arms.size):
+            v += kappa_arms[i] * D[j, i] * math.exp(-(t - tj[j]) / tau_arms[i])
+        if math.isnan(v_prev):
+            total += v * xi[j]  # flat from the centre to the first contact element
+        else:
+            total += 0.5 * (v + v_prev) * (xi[j] - x_prev)
+        x_prev, v_prev = xi[j], v
+    v_a = _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha, mem)
+    if not math.isnan(v_prev):
+        total += 0.5 * (v_a + v_prev) * (alpha - x_prev)
+    else:
+        total += v_a * alpha
+    return total

@@ -62,10 +62,6 @@ class ContactSolver(Solver):
             out.append(problem_line(
                 "output.snapshots", list(scene.output.snapshots), "the contact solver stores "
                 "no displacement profiles yet"))
-        if scene.loading.kind == "path" and scene.geometry.kind != "flat_punch":
-            out.append(problem_line("geometry.kind", scene.geometry.kind,
-                                    "smooth indenters on a loading path come with the next "
-                                    "release"))
         return out
 
     def solve(self, scene, observers) -> Result:
@@ -97,8 +93,9 @@ def _time_scale(scene, setup) -> float:
     if scene.loading.kind == "constant_velocity":
         t = frozen_detach_time(Problem.from_scene(scene), math.inf)
         return t if math.isfinite(t) and t > 0.0 else 1.0
+    # A path's own progress (lift, force, edges) sizes its steps; time only bounds them.
     known = [d.end[1] for d in setup.drives if d.end[0] == "time"]
-    return max(known) if known else 1.0
+    return max(known + [1e3])
 
 
 def _controlled(run) -> np.ndarray:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from scipy.optimize import brentq
+import numpy as np
 
 from . import contact_state as st
 
@@ -26,7 +26,67 @@ class Lost(Exception):
 _XTOL = 1e-14
 
 
-def _root(f, x_held, f_held, x_guess, lo, hi):
+def _secant(f, x_held, f_held, x_guess, lo, hi, reach):
+    """Secant iterations from the last state and the predictor, bracketed once a sign change
+    is seen: a few evaluations where the predictor is good; None if they wander off."""
+    x0, f0 = x_held, f_held
+    x1 = min(max(x_guess, lo), hi)
+    if x1 == x0:
+        return None
+    f1 = f(x1)
+    bracket = None
+    for _ in range(40):
+        if math.isnan(f1):
+            return None
+        if f1 == 0.0 or abs(f1) <= 1e-14:
+            return x1
+        if (f1 > 0.0) != (f0 > 0.0):
+            bracket = (min(x0, x1), max(x0, x1))
+        elif bracket is not None and not bracket[0] <= x1 <= bracket[1]:
+            return None
+        if abs(x1 - x0) <= _XTOL * max(abs(x1), 1e-300) and bracket is not None:
+            return x1
+        x2 = x1 - f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else math.nan
+        if bracket is not None and not bracket[0] < x2 < bracket[1]:
+            x2 = 0.5 * (bracket[0] + bracket[1])
+        if not (lo <= x2 <= hi) or abs(x2 - x_held) > reach:
+            return None
+        f2 = f(x2)
+        if bracket is not None and not math.isnan(f2):
+            a, b = bracket
+            # keep the sign change between the newest point and the side it pairs with
+            if (f2 > 0.0) != (f1 > 0.0):
+                bracket = (min(x1, x2), max(x1, x2))
+            else:
+                keep = x0 if (f0 > 0.0) != (f2 > 0.0) else (a if x2 > 0.5 * (a + b) else b)
+                bracket = (min(keep, x2), max(keep, x2))
+        x0, f0, x1, f1 = x1, f1, x2, f2
+    return None
+
+
+def _bracketed(f, a, fa, b, fb):
+    """A root of ``f`` between ``a`` and ``b`` (a sign change), Illinois regula falsi with
+    bisection where it stalls; None if ``f`` turns nan inside."""
+    for _ in range(200):
+        if abs(b - a) <= _XTOL * max(abs(a), abs(b), 1e-300):
+            return b if abs(fb) <= abs(fa) else a
+        x = b - fb * (b - a) / (fb - fa)
+        if not min(a, b) < x < max(a, b):
+            x = 0.5 * (a + b)
+        fx = f(x)
+        if math.isnan(fx):
+            return None
+        if fx == 0.0 or abs(fx) <= 1e-15:
+            return x
+        if (fx > 0.0) != (fb > 0.0):
+            a, fa = b, fb
+        else:
+            fa *= 0.5  # Illinois: the kept end's value is halved so it cannot stall
+        b, fb = x, fx
+    return b
+
+
+def _root(f, x_held, f_held, x_guess, lo, hi, wide=False):
     """The root of ``f`` nearest ``x_held`` inside ``[lo, hi]`` (the branch the solution is
     on): brackets grow from ``x_held`` geometrically, the side of ``x_guess`` first, until
     ``f`` changes sign; None if it does not within a reach of a quarter of ``x_held`` (or of
@@ -35,10 +95,16 @@ def _root(f, x_held, f_held, x_guess, lo, hi):
         return x_held
     first = 1.0 if x_guess >= x_held else -1.0
     reach = max(4.0 * abs(x_guess - x_held), 0.25 * max(abs(x_held), 1.0))
+    if wide:  # a jump: the new state may be anywhere
+        reach = math.inf
     lo, hi = max(lo, x_held - reach), min(hi, x_held + reach)
+    if x_guess != x_held:
+        quick = _secant(f, x_held, f_held, x_guess, lo, hi, reach)
+        if quick is not None:
+            return quick
     step = max(abs(x_guess - x_held), 1e-7 * max(abs(x_held), 1.0))
     ends = {first: (x_held, f_held), -first: (x_held, f_held)}
-    for _ in range(80):
+    for _ in range(200 if wide else 80):
         for direction in (first, -first):
             a, fa = ends[direction]
             b = min(max(x_held + direction * step, lo), hi)
@@ -54,8 +120,7 @@ def _root(f, x_held, f_held, x_guess, lo, hi):
             if fb == 0.0:
                 return b
             if (fb > 0.0) != (fa > 0.0):
-                return brentq(f, min(a, b), max(a, b), xtol=_XTOL * max(abs(b), 1e-300),
-                              rtol=1e-15, maxiter=200)
+                return _bracketed(f, a, fa, b, fb)
             ends[direction] = (b, fb)
         if ends[1.0][0] >= hi and ends[-1.0][0] <= lo:
             return None
@@ -98,7 +163,8 @@ def receding(step, H, guess_alpha):
         return step.evaluate(alpha, _edge_zone(step, H, alpha), H).gap - 1.0
 
     r_held = residual(now.alpha)
-    alpha = _root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha)
+    alpha = _root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha,
+                  step.jump)
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
     return step.evaluate(alpha, _edge_zone(step, H, alpha), H)
@@ -123,7 +189,8 @@ def zone_end(step, H, alpha, guess_beta, top=math.inf):
         return step.evaluate(alpha, beta, H).gap - 1.0
 
     start = min(max(now.beta, alpha * (1.0 + 1e-12), 1e-12), top)
-    beta = _root(residual, start, residual(start), min(max(guess_beta, alpha), top), alpha, top)
+    beta = _root(residual, start, residual(start), min(max(guess_beta, alpha), top), alpha, top,
+                 step.jump)
     if beta is None:
         raise Lost("zone")
     return step.evaluate(alpha, beta, H)
@@ -136,9 +203,9 @@ def zone_only(step, H, guess_beta):
     elastic punch, whose zone would have to grow, comes off at once; MODEL.md section 6)."""
     flat = step.s.setup.flat
     ev = zone_end(step, H, 0.0, guess_beta, step.now.beta if flat else math.inf)
-    if flat and ev.H - ev.centre_u < -1e-12 * max(abs(ev.H), 1.0):
-        # The zone could hold the punch only with the solid passing through its face:
-        # there is no zone-only state, the punch comes off.
+    if ev.H - ev.centre_u < -1e-9 * max(abs(ev.H), 1.0) and (flat or step.jump):
+        # A zone-only state with the solid passing through the indenter is none: a flat
+        # punch comes off, a smooth indenter's jump lands in contact instead.
         raise Lost("zone")
     return ev
 
@@ -158,11 +225,62 @@ def smooth_contact(step, H, guess_alpha, guess_beta):
     return held
 
 
+def _newton2(residual, x0, scale, max_iter=12):
+    """Damped Newton on two unknowns with a forward-difference Jacobian; None if it fails."""
+    x = np.array(x0, dtype=float)
+    try:
+        ev, r = residual(x)
+    except Lost:
+        return None
+    for _ in range(max_iter):
+        if np.all(np.abs(r) <= 1e-13):
+            return ev
+        J = np.empty((2, 2))
+        for j in range(2):
+            dx = x.copy()
+            dx[j] += 1e-7 * scale[j]
+            try:
+                J[:, j] = (residual(dx)[1] - r) / (1e-7 * scale[j])
+            except Lost:
+                return None
+        try:
+            step = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(step)):
+            return None
+        lam, norm = 1.0, np.linalg.norm(r)
+        while lam >= 1.0 / 64:
+            try:
+                ev_t, r_t = residual(x + lam * step)
+                if np.all(np.isfinite(r_t)) and np.linalg.norm(r_t) < (1 - 1e-4 * lam) * norm:
+                    break
+            except Lost:
+                pass
+            lam *= 0.5
+        else:
+            return ev if np.all(np.abs(r) <= 1e-10) else None
+        x, ev, r = x + lam * step, ev_t, r_t
+    return ev if np.all(np.abs(r) <= 1e-10) else None
+
+
 def advancing(step, H, guess_alpha, guess_beta):
-    """The edge advances to where a free element meets the indenter (the zone end from the
-    gap at each trial edge)."""
+    """The edge advances to where a free element meets the indenter, the zone end where the
+    gap is delta: Newton on both from the predictor, else the zone end solved inside a search
+    for the edge."""
     now = step.now
     ind = step.s.setup.indenter
+    if not step.jump and guess_alpha > now.alpha:
+        def both(x):
+            a = max(x[0], now.alpha)
+            ev = step.evaluate(a, max(x[1], a), H)
+            return ev, np.array([ev.gap - 1.0, ev.edge_free_u - H - ind.g(a)])
+
+        width = max(guess_beta - guess_alpha, 1e-6 * max(guess_beta, 1.0))
+        ev = _newton2(both, (guess_alpha, max(guess_beta, guess_alpha + width)),
+                      (max(guess_alpha, 1.0), width))
+        if ev is not None and ev.alpha > now.alpha and ev.beta > ev.alpha:
+            return ev
     cache = {}
 
     def residual(alpha):
@@ -173,7 +291,7 @@ def advancing(step, H, guess_alpha, guess_beta):
     r_held = residual(now.alpha)
     hi = max(guess_alpha, now.alpha) * 4.0 + 1.0
     alpha = _root(residual, now.alpha, r_held, max(guess_alpha, now.alpha * (1 + 1e-9) + 1e-12),
-                  now.alpha, hi)
+                  now.alpha, math.inf if step.jump else hi, step.jump)
     if alpha is None:
         raise Lost("advance")
     return zone_end(step, H, alpha, cache.get("beta", guess_beta))

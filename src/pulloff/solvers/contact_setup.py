@@ -70,8 +70,10 @@ class Law:
             one = np.ones((1, 1))
             return cls(k_inf, c, empty, empty, np.array([-k_inf / c]), np.array([1.0 / c]),
                        np.array([1.0]), 0.0, one, one)
-        return cls(k_inf, 0.0, empty, empty, empty, empty, empty, 1.0 / k_inf,
-                   np.zeros((0, 0)), np.zeros((0, 0)))
+        # Elastic: no state. One idle mode keeps every array two-dimensional.
+        one = np.ones((1, 1))
+        return cls(k_inf, 0.0, empty, empty, np.zeros(1), np.zeros(1), np.zeros(1),
+                   1.0 / k_inf, one, one)
 
 
 @dataclass(frozen=True)

@@ -60,6 +60,16 @@ class Nodes:
         self.xi_max = max(self.xi_max, x)
         return i
 
+    def remove(self, drop: np.ndarray) -> None:
+        """Remove the elements whose indices are in ``drop``."""
+        keep = np.ones(self.n, dtype=bool)
+        keep[drop] = False
+        k = int(keep.sum())
+        for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+            arr = getattr(self, name)
+            arr[:k] = arr[:self.n][keep]
+        self.n = k
+
     def near(self, x: float, tol: float) -> bool:
         """Whether an element lies within ``tol`` of ``x``."""
         i = int(np.searchsorted(self.xi[:self.n], x))

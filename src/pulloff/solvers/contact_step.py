@@ -77,6 +77,23 @@ class Step:
         self.r = (now.t - before.t) / dt if before is not None else None
         self.before = before
         self.arm_mus = dt / law.tau_arms if law.maxwell else np.zeros(0)
+        self.jump = False  # a zero-time transition: the phase's root is searched widely
+        self.k_alpha = self.k_beta = 0  # new elements per step (set by the stepper)
+        self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv)
+        setup = stepper.setup
+        ind = setup.indenter
+        sc = np.zeros(17)
+        sc[[K.S_T0, K.S_DT, K.S_ALPHA0, K.S_BETA0, K.S_XIMAX, K.S_KAPPA, K.S_C, K.S_D,
+            K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G]] = (
+            now.t, dt, now.alpha, now.beta, stepper.nodes.xi_max, law.kappa_inf, law.c, law.d,
+            1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n)
+        self._constants = sc
+
+    @property
+    def constants(self):
+        sc = self._constants
+        sc[K.S_K_ALPHA], sc[K.S_K_BETA] = self.k_alpha, self.k_beta
+        return sc
 
     # --- paths over the step -------------------------------------------------------------
     def path(self, name, new):
@@ -129,68 +146,40 @@ class Step:
 
     # --- the free side -------------------------------------------------------------------
     def evaluate(self, alpha, beta, H_new) -> Evaluation:
-        """The end of the step for trial edges and lift."""
+        """The end of the step for trial edges and lift (:func:`pulloff.kernels.contact.
+        evaluate_step` advances every element)."""
         s = self.s
         nodes = s.nodes
         law = s.setup.law
         now = self.now
         Hdot = self.lift_rate(H_new)
         Hf = self.filtered_lift(H_new) if law.maxwell else now.Hf
-        bp = self.path("beta", beta)
         zone = beta > 0.0
+        bp = self.path("beta", beta)
         b_top = max(now.beta, beta, K.path_value(*bp, 0.5)) if zone else 0.0
         lo = nodes.below(min(now.alpha, alpha) - _TINY)
         if zone:
             hi = max(nodes.below(b_top * (1.0 + 1e-12) + _TINY), lo)
         else:  # no zone: only the element at the centre matters (its gap)
             hi = lo + 1 if nodes.n and nodes.xi[0] == 0.0 and lo == 0 else lo
-        xi, Y0, s0, virtual = self._elements(lo, hi, alpha, beta, H_new)
-        nm = law.n_modes
-        Y = np.zeros((xi.size, max(nm, 1)))
-        U = np.zeros(xi.size)
-        K.free_field(xi, Y0, s0, 0, xi.size, bp[0], bp[1], bp[2], self.mus, self.zdt,
-                     law.ctil, law.d, nm, self.w3, Y, U)
-        stays = np.zeros(xi.size, dtype=bool)
-        stays[:hi - lo] = (nodes.status[lo:hi] == CONTACT) & (nodes.xi[lo:hi] <= alpha)
-        U[stays] = H_new + s.setup.indenter.g(xi[stays])
-        order = np.argsort(xi, kind="stable")
-        ev = Evaluation(alpha, beta, H_new, Hdot, math.nan, math.nan, math.nan, 0.0, 0.0,
-                        math.nan, lo, hi, Y[order], U[order], Hf)
-        ev.xi, ev.virtual, ev.stays = xi[order], virtual[order], stays[order]
+        paths = np.array([self.path("alpha", alpha), bp, self.lift_path(H_new)])
+        sc = self.constants.copy()
+        sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+        size = (hi - lo) + self.k_alpha + self.k_beta
+        nm = self.mus.size
+        out = (np.empty(size), np.empty((size, nm)), np.empty(size),
+               np.empty(size, dtype=np.int64))
+        res = np.empty(K.R_N)
+        mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+        stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf)
+        m = K.evaluate_step(mesh, self.law, stepw, paths, sc, lo, hi, alpha, beta, nodes.n,
+                            out, res)
+        ev = Evaluation(alpha, beta, H_new, Hdot, res[K.R_GAP], res[K.R_EDGE_LOAD],
+                        res[K.R_EDGE_FREE_U], res[K.R_F_CONTACT], res[K.R_F_TOTAL],
+                        res[K.R_CENTRE_U], lo, hi, out[1][:m], out[2][:m], Hf)
+        ev.xi, ev.virtual, ev.stays = out[0][:m], out[3][:m] == 1, out[3][:m] == 2
         ev.dt = self.dt
-        s.finish_evaluation(self, ev, bp)
         return ev
-
-    def _elements(self, lo, hi, alpha, beta, H_new):
-        """The elements a step advances: the existing ones ``lo..hi-1`` and the new ones it
-        places where the receding edge releases the solid or the zone end enters virgin
-        solid. Returns positions, modes at the start of each one's free stretch, where that
-        stretch starts (0, or the fraction at which the edge releases it), and which are new."""
-        nodes = self.s.nodes
-        law = self.s.setup.law
-        nm = law.n_modes
-        width = max(nm, 1)
-        Y0 = nodes.Y[lo:hi, :width].copy()
-        if nm:
-            lag = (self.now.t - nodes.t_last[lo:hi]) / self.dt  # elements beyond the zone
-            if np.any(lag > 0.0):
-                Y0 *= np.exp(-np.outer(lag, self.mus))
-        s0 = np.zeros(hi - lo)
-        ap = self.path("alpha", alpha)
-        released = np.nonzero((nodes.status[lo:hi] == CONTACT) & (nodes.xi[lo:hi] > alpha))[0]
-        for j in released:
-            s0[j] = _crossing(ap, nodes.xi[lo + j])
-            if nm:
-                Y0[j] = self.released_modes(nodes.xi[lo + j], s0[j], H_new)
-        new_x = self.s.new_elements(self, alpha, beta)
-        new_s0 = np.array([_crossing(ap, x) if x < self.now.alpha else 0.0 for x in new_x])
-        new_Y = np.zeros((new_x.size, width))
-        for j, x in enumerate(new_x):
-            if x < self.now.alpha and nm:
-                new_Y[j] = self.released_modes(x, new_s0[j], H_new)
-        virtual = np.concatenate([np.zeros(hi - lo, dtype=bool), np.ones(new_x.size, dtype=bool)])
-        return (np.concatenate([nodes.xi[lo:hi], new_x]), np.vstack([Y0, new_Y]),
-                np.concatenate([s0, new_s0]), virtual)
 
 
 def _crossing(p, x):

@@ -31,7 +31,7 @@ from .contact_step import Evaluation, Step
 
 #: Nodes per zone width at resolution n = 64 (they grow like sqrt(n): the gap quadrature is
 #: fourth order in their spacing, the step second order).
-_NODES_PER_ZONE = 12.0
+_NODES_PER_ZONE = 16.0
 #: Elements placed per step where the zone end enters virgin solid (evenly in angle).
 ENTRY_NODES = 4
 #: Steps a run may take (per level).
@@ -60,6 +60,12 @@ class Stepper:
         self.phase_row = 0  # the row where the current phase began
         self.segment = 0
         self.last_dt = None
+        # The ranges the lift and the force are measured in (grow with what is seen).
+        self.H_range = max([1.0, abs(setup.h0)] + [abs(d.end[1]) for d in setup.drives
+                                                    if d.end[0] == "lift"]
+                           + [t_scale * abs(d.rate) for d in setup.drives
+                              if d.kind == "speed" and d.end == ("event", "end")])
+        self.F_range = max([1e-3] + [abs(d.end[1]) for d in setup.drives if d.end[0] == "force"])
         self.now = self._start()
         self.before = None
         self._begin_segment()
@@ -101,8 +107,8 @@ class Stepper:
             else None
         if ev is not None:
             now.gap, now.F_contact, now.F_total = ev.gap, ev.F_contact, ev.F_total
-        else:
-            now.gap = H0 - 0.0
+        else:  # apart: the solid at rest, the gap is the tip's lift
+            now.gap, now.centre_u = H0, 0.0
         self._row(now)
         return now
 
@@ -139,71 +145,6 @@ class Stepper:
         """``sum_i kappa_i D_i e^{-(t - tj)/tau_i}``: the arms' memory in the contact load."""
         return float(np.dot(self.setup.law.kappa_arms, self.contact_memory_arms(xi, t)))
 
-    def finish_evaluation(self, step: Step, ev: Evaluation, bp) -> None:
-        """Gap, edge loads and forces of an evaluation."""
-        s = self.setup
-        ind = s.indenter
-        nodes = self.nodes
-        alpha, beta, H = ev.alpha, ev.beta, ev.H
-        xi = ev.xi
-        centre = np.nonzero(xi == 0.0)[0]
-        ev.centre_u = float(ev.U[centre[0]]) if centre.size else math.nan
-        if beta <= 0.0:
-            ev.gap = H - ev.centre_u if centre.size else math.inf
-            ev.edge_load = ev.edge_free_u = math.nan
-            return
-        ell = math.sqrt(max((beta - alpha) * (beta + alpha), 0.0))
-        if beta > nodes.xi_max * (1.0 + 1e-12) + 1e-300 and beta > step.now.beta:
-            U_beta = 0.0  # the zone end enters virgin solid, still at rest
-        else:
-            U_beta = math.nan
-        U_alpha = H + ind.g(alpha) if alpha > 0.0 else ev.centre_u
-        integral = K.free_gap_integral(xi, ev.U, 0, xi.size, alpha, beta, U_alpha, U_beta)
-        contact = K.profile_integral(ind.C, ind.n, alpha, beta)
-        ev.gap = ((2.0 / math.pi) * H * math.atan2(ell, alpha) + ind.f(beta)
-                  - (2.0 / math.pi) * (contact + integral))
-        ev.edge_load = step.contact_load(alpha, H, ev.Hdot, ev.Hf) if alpha > 0.0 else 0.0
-        ev.edge_free_u = self._free_u_at(xi, ev.U, alpha)
-        zone_force = 2.0 * (beta * beta * math.atan2(ell, alpha) - alpha * ell)
-        ev.F_contact = 4.0 * self._contact_force(step, ev)
-        ev.F_total = ev.F_contact + zone_force
-
-    def _free_u_at(self, xi, U, alpha):
-        """A free element's displacement at ``alpha``: the cubic through the nearest elements
-        on both sides (the ones the advancing edge captures count as if still free)."""
-        j = int(np.searchsorted(xi, alpha))
-        lo, hi = max(0, j - 2), min(xi.size, j + 2)
-        if hi - lo < 2:
-            return math.nan
-        return K.interpolate_cubic(xi[lo:hi].copy(), U[lo:hi].copy(), alpha)
-
-    def _contact_force(self, step, ev):
-        """``int_0^alpha Q dxi`` of the contact elements."""
-        law = self.setup.law
-        ind = self.setup.indenter
-        a = ev.alpha
-        if a <= 0.0:
-            return 0.0
-        base = law.kappa_inf * (ev.H * a + ind.g_integral(a))
-        if not law.maxwell:
-            return base + law.c * ev.Hdot * a
-        base += a * float(np.dot(law.kappa_arms, ev.H - ev.Hf))
-        return base - self._memory_integral(a, step.now.t + step.dt)
-
-    def _memory_integral(self, alpha, t):
-        """``int_0^alpha`` of :meth:`contact_memory` (trapezoid over the contact elements)."""
-        nodes = self.nodes
-        law = self.setup.law
-        idx = np.nonzero((nodes.status[:nodes.n] == st.CONTACT) & (nodes.xi[:nodes.n] < alpha))[0]
-        if idx.size == 0:
-            return 0.0
-        x = np.append(nodes.xi[idx], alpha)
-        m = law.tau_arms.size
-        mem = (nodes.D[idx, :m] * np.exp(-(t - nodes.tj[idx])[:, None] / law.tau_arms)) @ \
-            law.kappa_arms
-        mem = np.append(mem, self.contact_memory(alpha, t))
-        return float(np.trapezoid(mem, x)) if hasattr(np, "trapezoid") else float(np.trapz(mem, x))
-
     # --- history ---------------------------------------------------------------------------
     def _row(self, now):
         self.rows.append((now.t, now.H, now.alpha, now.beta, now.gap, now.F_contact,
@@ -215,24 +156,6 @@ class Stepper:
         """Target distance between elements: a ``per_zone``-th of the zone's width."""
         width = now.beta - now.alpha if now.beta > now.alpha else now.beta
         return max(width, 1e-9 * max(now.beta, 1.0)) / self.per_zone
-
-    def new_elements(self, step, alpha, beta):
-        """Positions of the elements a trial step places: ``step.k_alpha`` evenly over what a
-        receding flat punch releases (ending on the new edge), ``step.k_beta`` over what the
-        zone end adds of virgin solid (ending on the new zone end)."""
-        now = step.now
-        out = []
-        if self.setup.flat and alpha < now.alpha and step.k_alpha:
-            k = step.k_alpha
-            out.append(now.alpha + (alpha - now.alpha) * np.arange(1, k + 1) / k)
-        start = max(now.beta, self.nodes.xi_max)
-        if beta > start and step.k_beta:
-            # Evenly spaced in the angle theta = acos(x/b) the gap is integrated in: the load
-            # of an element that just entered grows like a power of its distance to b, which
-            # is smooth in theta, not in x.
-            k = step.k_beta
-            out.append(beta - (beta - start) * ((k - np.arange(1, k + 1)) / k) ** 2)
-        return np.concatenate(out) if out else np.zeros(0)
 
     def make_step(self, dt) -> Step:
         """A trial step of ``dt``, with the number of new elements chosen from the motion the
@@ -246,7 +169,15 @@ class Stepper:
             grow_a = max(before.alpha - now.alpha, 0.0) * rate
             grow_b = max(now.beta - before.beta, 0.0) * rate
         step.k_alpha = max(1, int(math.ceil(grow_a / h)))
+        # Entering elements evenly in angle, at least per_zone across the zone's angle.
         step.k_beta = ENTRY_NODES
+        if grow_b > 0.0 and now.beta > 0.0:
+            beta_next = now.beta + grow_b
+            start = max(now.beta, self.nodes.xi_max, 0.0)
+            swept = math.acos(min(start / beta_next, 1.0))
+            zone = math.atan2(math.sqrt(max((now.beta - now.alpha) * (now.beta + now.alpha), 0.0)),
+                              now.alpha) if now.alpha > 0.0 else 0.5 * math.pi
+            step.k_beta = max(ENTRY_NODES, int(math.ceil(self.per_zone * swept / max(zone, 1e-300))))
         return step
 
     # --- running -----------------------------------------------------------------------------
@@ -264,14 +195,23 @@ class Stepper:
                 progress(1)
 
     def _next_dt(self, t_end) -> float:
+        """About ``1/n`` of the step measure: time in ``t_scale``, the edges' travel in the
+        zone's size, the lift's in its range, the force's in its range (each rate from the
+        last step, at most doubling per step)."""
         now, before = self.now, self.before
         dt = self.t_scale / self.n
+        if self.lift_driven and self.drive.kind == "speed":
+            dt = min(dt, self.H_range / (self.n * abs(self.drive.rate)))
+        self.H_range = max(self.H_range, abs(now.H))
+        self.F_range = max(self.F_range, abs(now.F_total))
         if before is not None and now.t > before.t:
             dt_prev = now.t - before.t
             scale = max(1.0, now.beta)
             rate = (1.0 / self.t_scale
-                    + (abs(now.alpha - before.alpha) + abs(now.beta - before.beta))
-                    / (scale * dt_prev))
+                    + (abs(now.alpha - before.alpha) + abs(now.beta - before.beta)) / scale
+                    / dt_prev
+                    + abs(now.H - before.H) / self.H_range / dt_prev
+                    + abs(now.F_total - before.F_total) / self.F_range / dt_prev)
             dt = min(1.0 / (self.n * rate), 2.0 * dt_prev)
         elif self.last_dt is not None:
             dt = min(dt, self.last_dt)
@@ -487,8 +427,8 @@ class Stepper:
         # A sliver this thin released at once changes the gap by ~(sliver)^2.
         if what == "contact":
             return now.alpha <= 1e-6 * max(now.beta, 1.0)
-        if what == "zone":
-            return now.beta <= 1e-6
+        if what == "zone":  # a vanishing zone, not one being born
+            return now.beta <= 1e-6 and not self._growing_zone()
         return False
 
     # --- committing a step ---------------------------------------------------------------------
@@ -516,6 +456,7 @@ class Stepper:
                                  driver=self.now.driver + self._driver_rate() * step.dt)
         self._row(self.now)
         replay.refine(self)
+        replay.thin(self)
 
     def _driver_rate(self) -> float:
         drive = self.drive
@@ -561,12 +502,18 @@ class Stepper:
             now.phase = st.ZONE
             return self._physical_end("onset")
         if what == "contact":
+            at_limit = self._at_limit("contact")
             self._release_all()
             now.phase = st.ZONE
+            if not self.setup.flat and not at_limit:
+                return self._jump("out")
             return
+        if what == "advance":
+            return self._jump("in")
         if what in ("separation", "zone", "balance"):
             if what == "zone" and self._growing_zone():
-                return self._touch()
+                self._touch()
+                return self._jump("in")
             now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
             self.events.append((now.t, "separated"))
             self._row(now)
@@ -581,12 +528,39 @@ class Stepper:
         raise RuntimeError(f"unknown event {what!r}")  # a bug, not input
 
     def _growing_zone(self) -> bool:
-        """Whether a zone-only branch ended while the zone grew (an approach: the surface
-        jumps into contact), not while it shrank (the surfaces come apart). A flat punch
-        never re-bonds."""
+        """Whether a zone-only branch ended while the zone grew or was just born (an approach:
+        the surface jumps into contact), not while it shrank (the surfaces come apart). A
+        flat punch never re-bonds."""
         rows = self.rows
-        return (not self.setup.flat and len(rows) > 2 and rows[-1][3] > rows[-2][3]
-                and self.events[-2:-1] != [(self.now.t, "contact")])
+        if self.setup.flat or self.events[-2:-1] == [(self.now.t, "contact")]:
+            return False
+        born = [t for t, name in self.events if name == "birth"]
+        just_born = bool(born) and rows[self.phase_row][3] <= 0.0
+        return just_born or (len(rows) > 2 and rows[-1][3] > rows[-2][3])
+
+    def _jump(self, kind) -> None:
+        """A zero-time transition (a fold of the branch): the new state at the same time,
+        searched widely, recorded as its own row; ``in`` lands in contact, ``out`` in the
+        zone alone (or apart, when no zone holds)."""
+        now = self.now
+        step = Step(self, now, 1e-12 * self.t_scale, None)
+        step.k_alpha, step.k_beta, step.jump = 1, int(4 * self.per_zone), True
+        try:
+            ev = self.solve(step)
+        except phases.Lost:
+            if kind == "in":
+                raise RuntimeError(f"no contact state to jump into at t = {now.t}") from None
+            self.events.append((now.t, "jump_out"))
+            now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
+            self.events.append((now.t, "separated"))
+            self._row(now)
+            return self._physical_end("separation")
+        self.events.append((now.t, f"jump_{kind}"))
+        self.kinks.add(len(self.rows) - 1)
+        self.commit(step, ev)
+        self.kinks.add(len(self.rows) - 1)
+        self.phase_row = len(self.rows) - 1
+        self.before = None
 
     def _touch(self) -> None:
         """The surface meets the indenter at the centre: contact begins there."""
