@@ -476,7 +476,7 @@ def interpolate_cubic(xs, fs, x):
 R_GAP, R_EDGE_LOAD, R_EDGE_FREE_U, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(7)
 #: Indices of the step constants ``sc`` of :func:`evaluate_step`.
 (S_T0, S_DT, S_ALPHA0, S_BETA0, S_H1, S_HDOT, S_XIMAX, S_KAPPA, S_C, S_D, S_FLAT, S_AF, S_C_G,
- S_N_G, S_K_ALPHA, S_K_BETA, S_JUMP) = range(17)
+ S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH) = range(17)
 
 
 @njit(cache=True)
@@ -573,12 +573,18 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, out):
     alpha0 = sc[S_ALPHA0]
     k_a = int(sc[S_K_ALPHA]) if (sc[S_FLAT] > 0.0 and alpha1 < alpha0) else 0
     start = max(sc[S_BETA0], sc[S_XIMAX], 0.0)
+    fresh = sc[S_FRESH] > 0.0
+    if fresh:
+        # A solid without history (elastic): new elements evenly in angle over the whole
+        # zone, the centre included, stand for every existing free one.
+        start, k_a, hi = alpha1, 0, lo
     k_b = int(sc[S_K_BETA]) if beta1 > start else 0
     theta_b = math.acos(min(start / beta1, 1.0)) if k_b > 0 else 0.0
+    first_b = 0 if (fresh and start == 0.0) else 1
     m = 0
     y0 = np.zeros(max(nm, 1))
     ints = np.empty(max(nm, 1))
-    for j in range(k_a + (hi - lo) + k_b):
+    for j in range(k_a + (hi - lo) + k_b + 1 - first_b):
         s0 = 0.0
         for k in range(nm):
             y0[k] = 0.0
@@ -609,8 +615,8 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, out):
                 for k in range(nm):
                     y0[k] = Y[i, k] * (math.exp(-mus[k] * lag) if lag > 0.0 else 1.0)
         else:  # entering virgin solid, evenly in angle toward the zone end
-            jj = j - k_a - (hi - lo) + 1
-            x = beta1 * math.cos(theta_b * (k_b - jj) / k_b)
+            jj = j - k_a - (hi - lo) + first_b
+            x = beta1 * math.cos(theta_b * (k_b - jj) / k_b) if jj > 0 else start
             flag = 1
         q1 = load_integrals(bp[0], bp[1], bp[2], x, s0, 1.0, mus, nm, w3, ints)
         u = sc[S_D] * q1

@@ -210,12 +210,31 @@ def zone_only(step, H, guess_beta):
     return ev
 
 
+def elastic_contact(step, H, guess_alpha):
+    """An elastic solid in contact: it has no history, so the edge condition holds whichever
+    way the edge moves, and the zone end it gives leaves one unknown, the edge."""
+    now = step.now
+
+    def residual(alpha):
+        return step.evaluate(alpha, _edge_zone(step, H, alpha), H).gap - 1.0
+
+    start = max(now.alpha, 1e-12)
+    alpha = _root(residual, start, residual(start), max(guess_alpha, 1e-12), 0.0, math.inf,
+                  step.jump)
+    if alpha is None or alpha <= 0.0:
+        raise Lost("contact")
+    return step.evaluate(alpha, _edge_zone(step, H, alpha), H)
+
+
 def smooth_contact(step, H, guess_alpha, guess_beta):
     """A smooth indenter in contact: ``gap(b) = delta`` always; the edge recedes where the
     contact element would pull harder than the zone (a tensile singularity), advances where a
     free element would pass through the indenter, and sticks otherwise."""
     now = step.now
     ind = step.s.setup.indenter
+    law = step.s.setup.law
+    if law.c == 0.0 and not law.maxwell:
+        return elastic_contact(step, H, guess_alpha)
     held = zone_end(step, H, now.alpha, guess_beta)
     ell = math.sqrt(max((held.beta - now.alpha) * (held.beta + now.alpha), 0.0))
     if held.edge_load > ell:

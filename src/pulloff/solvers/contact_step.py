@@ -83,16 +83,19 @@ class Step:
         setup = stepper.setup
         ind = setup.indenter
         sc = np.zeros(17)
+        # An elastic smooth contact has no history: each evaluation places its own elements.
+        self.fresh = not setup.flat and law.c == 0.0 and not law.maxwell
         sc[[K.S_T0, K.S_DT, K.S_ALPHA0, K.S_BETA0, K.S_XIMAX, K.S_KAPPA, K.S_C, K.S_D,
-            K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G]] = (
+            K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G, K.S_FRESH]] = (
             now.t, dt, now.alpha, now.beta, stepper.nodes.xi_max, law.kappa_inf, law.c, law.d,
-            1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n)
+            1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n, 1.0 if self.fresh else 0.0)
         self._constants = sc
 
     @property
     def constants(self):
         sc = self._constants
-        sc[K.S_K_ALPHA], sc[K.S_K_BETA] = self.k_alpha, self.k_beta
+        k_beta = max(self.k_beta, int(4 * self.s.per_zone)) if self.fresh else self.k_beta
+        sc[K.S_K_ALPHA], sc[K.S_K_BETA] = self.k_alpha, k_beta
         return sc
 
     # --- paths over the step -------------------------------------------------------------
@@ -165,7 +168,9 @@ class Step:
         paths = np.array([self.path("alpha", alpha), bp, self.lift_path(H_new)])
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
-        size = (hi - lo) + self.k_alpha + self.k_beta
+        if self.fresh:
+            lo = hi = 0
+        size = (hi - lo) + self.k_alpha + int(sc[K.S_K_BETA]) + 1
         nm = self.mus.size
         out = (np.empty(size), np.empty((size, nm)), np.empty(size),
                np.empty(size, dtype=np.int64))

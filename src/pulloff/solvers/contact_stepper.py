@@ -446,8 +446,9 @@ class Stepper:
         nodes.Y[lo:hi] = ev.Y[~ev.virtual]
         nodes.t_last[lo:hi] = t1
         status[released] = st.FREE
-        for xv, Yv in zip(ev.xi[ev.virtual], ev.Y[ev.virtual]):
-            nodes.insert(float(xv), Yv, st.FREE, t_last=t1)
+        if not step.fresh:  # an elastic solid's evaluations place their own elements
+            for xv, Yv in zip(ev.xi[ev.virtual], ev.Y[ev.virtual]):
+                nodes.insert(float(xv), Yv, st.FREE, t_last=t1)
         self.before = self.now
         self.last_dt = step.dt
         self.now = self.now.copy(t=t1, H=ev.H, Hdot=ev.Hdot, alpha=ev.alpha, beta=ev.beta,
