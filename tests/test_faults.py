@@ -447,7 +447,7 @@ def test_show_csv_of_a_sweep_and_of_a_run(cut_sweep, tmp_path, capsys):
     assert main(["show", str(run), "--csv"]) == 0
     rows = list(csv.reader(io.StringIO(capsys.readouterr().out)))
     assert rows[0] == ["t [s]", "h [m]", "a [m]", "b [m]", "gap [m]", "F_contact [N]",
-                       "F_total [N]"]
+                       "F_total [N]", "segment [1]"]
     assert len(rows) - 1 == h5io.load(run)["history_rows_in_file"]
 
 

@@ -9,8 +9,10 @@ computed is kept in a valid file marked incomplete (exit 128 + the signal's numb
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -309,10 +311,28 @@ def _stop_like_ctrl_c(signum, frame):
     Ctrl-C: the solver or the sweep ends where it is and the file is written, marked
     incomplete. Further ones are ignored while that is done (a SIGKILL still ends it)."""
     _STOPPED_BY["signal"] = signum
+    _STOPPED_BY["arrived"] = True
     for name in ("SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_IGN)
     raise KeyboardInterrupt
+
+
+def _quiet_stop_in_callbacks(hook):
+    """A stop raised inside a C callback (numba's compiler) cannot propagate and Python would
+    print it as ignored: keep the console to the one line the stop reports."""
+
+    def quiet(info):
+        if not (_STOPPED_BY.get("arrived") and isinstance(info.exc_value, KeyboardInterrupt)):
+            hook(info)
+            return
+        # Swallowed there, the stop would be lost: deliver it again shortly, in Python code.
+        signum = _STOPPED_BY["signal"]
+        if signum != signal.SIGINT:
+            signal.signal(signum, _stop_like_ctrl_c)
+        threading.Timer(0.05, os.kill, (os.getpid(), signum)).start()
+
+    return quiet
 
 
 def _install_signal_handlers() -> None:
@@ -332,9 +352,12 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # a usage error (status 2, one line printed), --help, --version
         return exc.code if isinstance(exc.code, int) else 2
     _STOPPED_BY["signal"] = signal.SIGINT
+    _STOPPED_BY["arrived"] = False
     previous = {name: signal.getsignal(getattr(signal, name)) for name in ("SIGTERM", "SIGHUP")
                 if hasattr(signal, name)}
     _install_signal_handlers()
+    unraisable = sys.unraisablehook
+    sys.unraisablehook = _quiet_stop_in_callbacks(unraisable)
     try:
         return args.func(args)
     except BrokenPipeError:
@@ -349,10 +372,17 @@ def main(argv=None) -> int:
               f"keeps its finished rows: run the same command to resume)", file=sys.stderr)
         return _stop_status()
     except Exception as exc:  # a bug: say so in one line, with what to report
+        if _STOPPED_BY["arrived"]:
+            # The stop landed inside a callback (numba compiling): what failed after it is
+            # the stop's doing, not a bug.
+            print(f"pulloff {args.command}: {_stop_name()}; no partial file written",
+                  file=sys.stderr)
+            return _stop_status()
         print(f"pulloff {args.command}: internal error: {type(exc).__name__}: "
               f"{_one_line(exc)} (please report it with the scene file)", file=sys.stderr)
         return 1
     finally:
+        sys.unraisablehook = unraisable
         for name, handler in previous.items():
             try:
                 signal.signal(getattr(signal, name), handler)

@@ -21,7 +21,7 @@ from ..model.fields import fmt
 from ..model.scene import Scene, SceneError, validate_scene
 
 __all__ = ["Scene", "SceneError", "SceneLoader", "load_scene", "parse_scene", "apply_overrides", "override",
-           "scene_to_yaml", "read_yaml", "check_name", "group_values", "scene_from_groups"]
+           "scene_to_yaml", "read_yaml", "group_values", "scene_from_groups"]
 
 _TAGS = {name: f"tag:yaml.org,2002:{name}" for name in ("bool", "int", "float", "null")}
 _CORE_12 = {
@@ -127,37 +127,17 @@ def apply_overrides(data: Mapping, overrides: Sequence[str] | str) -> dict:
     return out
 
 
-def parse_scene(data: Mapping, overrides: Sequence[str] | str = ()) -> Scene:
+def parse_scene(data: Mapping, overrides: Sequence[str] | str = (), base=None) -> Scene:
     """Validate a scene given as a mapping (as read from YAML), after applying overrides, and
-    check that a solver honours every setting of it."""
+    check that a solver honours every setting of it. Files it names are read relative to
+    ``base`` (default: the working folder)."""
     from .. import solvers
 
     if not isinstance(data, Mapping):
         return validate_scene(data)  # raises with the allowed sections
-    scene = validate_scene(apply_overrides(data, overrides))
-    check_name(scene.name)
+    scene = validate_scene(apply_overrides(data, overrides), base=base)
     solvers.check(scene)
     return scene
-
-
-def check_name(name) -> None:
-    """A scene name is a name, not a path: it becomes ``runs/NAME.h5`` when no output is
-    given, so a path separator, ``..`` or a control character in it is a :class:`SceneError`
-    (not silently changed: the user sees what to fix)."""
-    if name is None:
-        return
-    problem = None
-    if "/" in name or "\\" in name:
-        problem = "holds a path separator"
-    elif name.strip() in (".", "..") or ".." in name.split("/"):
-        problem = "is '.' or '..'"
-    elif any(ord(c) < 32 or ord(c) == 127 for c in name):
-        problem = "holds a control character"
-    elif not name.strip():
-        problem = "is blank"
-    if problem:
-        raise SceneError(f"name = {fmt(name)}: {problem}; a scene name is a name, not a path "
-                         f"(set the output file with -o or output.path)")
 
 
 def override(scene: Scene, overrides: Sequence[str] | str) -> Scene:
@@ -175,7 +155,7 @@ def load_scene(path: str | Path, overrides: Sequence[str] | str = ()) -> Scene:
     if data is None:
         raise SceneError(f"{path}: empty scene file")
     try:
-        return parse_scene(data, overrides)
+        return parse_scene(data, overrides, base=Path(path).resolve().parent)
     except SceneError as e:
         raise SceneError([f"{path}: {p}" for p in e.problems]) from None
 

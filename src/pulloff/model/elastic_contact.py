@@ -77,7 +77,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 from scipy.special import betaincc, gammaln, roots_legendre
 from scipy.special import beta as beta_fn
 
@@ -648,6 +648,28 @@ def _refine(fun, lo, hi, fallback):
     return brentq(fun, lo, hi, xtol=1e-13, rtol=_RTOL)
 
 
+def _faceted_peak(fun, lo, hi, knots, per_facet=8):
+    """Radius [m] of the largest ``fun`` on [lo, hi] for a faceted (tabulated) profile: ``fun``
+    is smooth on each facet but kinked at the knots, so a derivative root is not the maximum
+    (a local one at best). Every knot and ``per_facet`` points inside each facet are sampled;
+    the best sample's neighbouring facets are then maximised as the smooth pieces they are."""
+    inside = knots[(knots > lo) & (knots < hi)]
+    edges = np.concatenate([[lo], inside, [hi]])
+    t = np.linspace(0.0, 1.0, per_facet + 2)[:-1]
+    xs = np.append((edges[:-1, None] + np.outer(np.diff(edges), t)).ravel(), hi)
+    vals = np.array([fun(x) for x in xs])
+    k = int(np.nanargmax(vals))
+    best_x, best_v = xs[k], vals[k]
+    j = min(np.searchsorted(edges, xs[k], side="right") - 1, edges.size - 2)
+    for m in (j - 1, j, j + 1):
+        if 0 <= m < edges.size - 1:
+            r = minimize_scalar(lambda x: -fun(x), bounds=(edges[m], edges[m + 1]),
+                                method="bounded", options={"xatol": 1e-12 * edges[m + 1]})
+            if -r.fun > best_v:
+                best_x, best_v = float(r.x), -float(r.fun)
+    return best_x
+
+
 def _contact_scale(profile, G, gamma, b0):
     """Largest radius [m] worth sampling: 4x the larger of the join radius and the JKR zero-force
     radius (where ``sqrt(8 pi E* gamma a^3) = 2 E* M(a)``; beyond it the contact is in
@@ -677,7 +699,9 @@ def mdr_dugdale_pulloff(profile, G, *, sigma_c=None, delta=None, gamma=None, con
     down to 1e-6 of the smaller of the JKR and join scales, then refined by a root of the
     5-point derivative in ``log a`` (each point an exact equilibrium): measured agreement with
     Maugis' analytic derivatives 3e-15 (load) and 1e-11 (displacement) for the sphere.  For a
-    :class:`TabulatedProfile` the displacement-control point is a facet's (see there).
+    :class:`TabulatedProfile` the load-control point is the largest over every facet and knot
+    (:func:`_faceted_peak`: a derivative root on a faceted curve finds a local maximum) and the
+    displacement-control point is a facet's (see there).
     """
     sigma_c, delta, gamma = _cohesive(sigma_c, delta, gamma)
     kw = dict(sigma_c=sigma_c, delta=delta)
@@ -707,7 +731,13 @@ def mdr_dugdale_pulloff(profile, G, *, sigma_c=None, delta=None, gamma=None, con
         i = int(np.argmax(F))
         if i == 0:
             raise ValueError("largest tension at a_max: raise a_max")
-        return PullOff(join.F_total, join.h, 0.0, b0, "join") if i == n else refine(i, "F_total")
+        if i == n:
+            return PullOff(join.F_total, join.h, 0.0, b0, "join")
+        if isinstance(profile, TabulatedProfile):
+            lo, hi = a[min(i + 2, n - 1)], a[max(i - 2, 0)]
+            return at(_faceted_peak(lambda x: state(x).F_total, lo, hi, profile.r_table),
+                      "contact")
+        return refine(i, "F_total")
     if control != "displacement":
         raise ValueError("control: 'load' or 'displacement'")
     # h = sigma_c c/(2G) - g(a) is rounded at ~eps (|h| + 2 g(a)); near the join

@@ -18,6 +18,9 @@ WHERE = {
     "seed": "the flat punch with its zone outside (the seed's closed forms)",
     "elastic_limit": "solids with a relaxed modulus G_inf > 0",
     "maxwell": "standard linear solids and Prony series (the instantaneous modulus)",
+    "path": "scenes with a loading path (loading.kind = path)",
+    "jump": "paths where the contact is gained or lost by a jump",
+    "sphere": "spheres",
 }
 
 
@@ -47,6 +50,7 @@ OUTPUTS = (
     _h("gap", "m", "gap between the surfaces at r = b"),
     _h("F_contact", "N", "force on the contact (bonded) region, tension positive"),
     _h("F_total", "N", "force of the whole line load: contact and cohesive zone"),
+    _h("segment", "1", "index of the loading segment (0 for a constant-speed pull)"),
 
     _s("detached", "", "whether the onset of detachment was reached", text=True),
     _s("t_detach", "s", "onset of detachment: first time with gap(b) = delta"),
@@ -60,6 +64,23 @@ OUTPUTS = (
     _s("F_peak_total", "N", "largest F_total of the run (the pull-off force)", "separation"),
     _s("t_peak_contact", "s", "time of the largest F_contact", "separation"),
     _s("t_peak_total", "s", "time of the largest F_total", "separation"),
+    _s("F_pulloff", "N", "the most tensile F_total of the path (the pull-off force)", "path"),
+    _s("h_pulloff", "m", "lift at F_pulloff (not error-controlled: the place of a smooth "
+                         "maximum is ill-conditioned)", "path"),
+    _s("t_pulloff", "s", "time of F_pulloff (not error-controlled, likewise)", "path"),
+    _s("F_max_compressive", "N", "the most compressive F_total of the path (negative)", "path"),
+    _s("F_jump_in", "N", "F_total just before the surface jumps into contact", "jump"),
+    _s("h_jump_in", "m", "lift where the surface jumps into contact", "jump"),
+    _s("F_jump_out", "N", "F_total just before the contact is lost by a jump", "jump"),
+    _s("h_jump_out", "m", "lift where the contact is lost by a jump", "jump"),
+    _s("energy_dissipated", "J", "int F_total dh over the whole path: the machine's net work, "
+                                 "the energy lost over a closed cycle", "path"),
+    _s("work_separation", "J", "int max(F_total, 0) dh over the last retraction: the work "
+                               "to pull the indenter off", "path"),
+    _s("maugis_lambda", "1", "Maugis' parameter 2 sigma_c (R / (pi gamma K^2))^(1/3), "
+                             "K = 16 G_inf / 3 (the relaxed modulus)", "sphere"),
+    _s("speed_relaxation", "1", "the last retraction speed times the longest relaxation "
+                                "time, over delta", "path"),
     _s("alpha", "1", "the seed's group pi delta sigma_c a G / (4 v^2 eta^2)", "pull"),
     _s("chi", "1", "elastic zone size pi G delta / (sigma_c a)", "pull"),
     _s("V", "1", "viscous against cohesive stress eta v / (sigma_c a)", "pull"),

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, model_validator
 
@@ -71,6 +71,7 @@ class Elastic(Rheology):
     """Linear elastic half-space."""
 
     kind: Literal["elastic"] = Field(description="rheology: elastic")
+    example: ClassVar[dict] = {"G": 1e6}
     G: Num = Field(gt=0, description="shear modulus, Pa")
 
     def spectrum(self) -> Spectrum:
@@ -82,6 +83,7 @@ class KelvinVoigt(Rheology):
     """Spring ``G`` parallel to a damper ``eta`` (the seed's solid)."""
 
     kind: Literal["kelvin_voigt"] = Field(description="rheology: kelvin_voigt")
+    example: ClassVar[dict] = {"G": 1e6, "eta": 1e3}
     G: Num = Field(ge=0, description="shear modulus, Pa")
     eta: Num = Field(ge=0, description="shear viscosity, Pa s")
 
@@ -101,6 +103,7 @@ class StandardLinearSolid(Rheology):
     """Relaxed spring ``G_inf`` parallel to one Maxwell arm (spring ``G_1``, time ``tau_1``)."""
 
     kind: Literal["standard_linear_solid"] = Field(description="rheology: standard_linear_solid")
+    example: ClassVar[dict] = {"G_inf": 1e6, "G_1": 9e6, "tau_1": 1e-3}
     G_inf: Num = Field(gt=0, description="relaxed (long-time) shear modulus, Pa")
     G_1: Num = Field(gt=0, description="shear modulus of the Maxwell arm, Pa")
     tau_1: Num = Field(gt=0, description="relaxation time of the Maxwell arm, s")
@@ -121,6 +124,8 @@ class Prony(Rheology):
     """Generalised Maxwell solid: ``G_inf`` and any number of arms."""
 
     kind: Literal["prony"] = Field(description="rheology: prony")
+    example: ClassVar[dict] = {"G_inf": 1e6, "terms": [{"G": 4e6, "tau": 1e-4},
+                                                       {"G": 5e6, "tau": 1e-2}]}
     G_inf: Num = Field(gt=0, description="relaxed (long-time) shear modulus, Pa")
     terms: list[PronyTerm] = Field(min_length=1,
                                    description="Maxwell arms of the Prony series, list of {G, tau}")

@@ -16,10 +16,10 @@ import typing
 from collections.abc import Mapping, Sequence
 from typing import Annotated, Any, Literal, Optional
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .adhesion import ADHESIONS
-from .fields import Int, NoBool, Num, bad_line, fmt
+from .fields import Int, NoBool, Num, bad, bad_line, fmt
 from .geometry import GEOMETRIES
 from .loading import LOADINGS
 from .rheology import RHEOLOGIES
@@ -103,6 +103,27 @@ class Scene(BaseModel):
     model: ModelSection = Field(default_factory=ModelSection, description="model variant section")
     numerics: Numerics = Field(default_factory=Numerics, description="solver accuracy section")
     output: Output = Field(default_factory=Output, description="output section")
+
+    @field_validator("name")
+    @classmethod
+    def _a_name_not_a_path(cls, name):
+        """A scene name becomes ``runs/NAME.h5`` when no output is given: a path separator,
+        ``..`` or a control character in it is an error (not silently changed)."""
+        if name is None:
+            return name
+        problem = None
+        if "/" in name or "\\" in name:
+            problem = "holds a path separator"
+        elif name.strip() in (".", ".."):
+            problem = "is '.' or '..'"
+        elif any(ord(c) < 32 or ord(c) == 127 for c in name):
+            problem = "holds a control character"
+        elif not name.strip():
+            problem = "is blank"
+        if problem:
+            raise bad(f"{problem}; a scene name is a name, not a path (set the output file "
+                      "with -o or output.path)")
+        return name
 
     def to_data(self) -> dict:
         """The scene as plain data in file form (``schema`` key, every default filled)."""
@@ -235,13 +256,15 @@ def unit_of(key: str) -> str:
     return "" if unit in ("no unit", "count", "text", "dimensionless") or " " in unit else unit
 
 
-def validate_scene(data: Mapping) -> Scene:
+def validate_scene(data: Mapping, base=None) -> Scene:
     """The pydantic validation of a scene given as a mapping (as read from YAML); raises
-    :class:`SceneError`. Whether a solver honours it is checked by :mod:`pulloff.solvers`."""
+    :class:`SceneError`. Files a scene names (a tabulated tip) are read relative to ``base``
+    (the scene file's folder; None: the working folder). Whether a solver honours the scene
+    is checked by :mod:`pulloff.solvers`."""
     if not isinstance(data, Mapping):
         raise SceneError(f"scene = {fmt(data)}: must be a mapping of sections "
                          f"(allowed: {_keys(Scene)})")
     try:
-        return Scene.model_validate(dict(data))
+        return Scene.model_validate(dict(data), context={"base": base})
     except ValidationError as e:
         raise SceneError([_problem(err, data) for err in e.errors()]) from None

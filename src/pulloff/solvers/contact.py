@@ -33,7 +33,8 @@ _FIRST_N = 16
 #: forces are not among them: the time of a smooth maximum is ill-conditioned (an error
 #: ``e`` in the force moves it by ``sqrt(e)``), so they are reported uncontrolled.
 CONTROLLED = ("t_detach", "F_total_detach", "F_contact_detach", "t_separation",
-              "F_peak_total", "F_peak_contact")
+              "F_peak_total", "F_peak_contact", "F_pulloff", "F_max_compressive", "F_jump_in",
+              "h_jump_in", "F_jump_out", "h_jump_out", "energy_dissipated")
 
 
 class ContactSolver(Solver):
@@ -83,8 +84,24 @@ class ContactSolver(Solver):
         result = ladder.refine(
             level, _controlled, scene.numerics.rtol, _FIRST_N, ORDER,
             can_refine=lambda run, n: 2 * len(run.rows) <= MAX_STEPS,
-            interrupted=lambda run: getattr(run, "interrupted", False), extrapolated=True)
+            interrupted=lambda run: getattr(run, "interrupted", False), extrapolated=True,
+            floor=_floor)
         return _result(scene, setup, result, observers, time.perf_counter() - wall)
+
+
+#: Outputs smaller than this share of their run's scale are judged against that share.
+FLOOR_SHARE = 1e-2
+
+
+def _floor(stepper) -> np.ndarray:
+    """Per controlled output, the size below which its error counts absolutely: a share of the
+    largest |force| (forces), of the lift's range (lifts), of their product (energies); times
+    are always relative."""
+    rows, s = np.array(stepper.rows), stepper.setup
+    force = np.max(np.abs(rows[:, 6])) * s.F0
+    lift = (np.ptp(rows[:, 1]) or np.max(np.abs(rows[:, 1]))) * s.delta
+    scale = {"F": force, "h": lift, "e": force * lift, "t": 0.0}
+    return np.array([FLOOR_SHARE * scale[name[0]] for name in CONTROLLED])
 
 
 def _time_scale(scene, setup) -> float:
@@ -105,7 +122,7 @@ def _controlled(run) -> np.ndarray:
 def peak(t: np.ndarray, F: np.ndarray, kinks=()):
     """``(t_peak, F_peak)`` of a sampled history: the largest sample, refined by the parabola
     through it and its neighbours where the maximum is smooth (not at an event, where the
-    history has a corner, as at an unstable crack's onset)."""
+    history has a corner: an unstable crack's onset, a tabulated tip's knot)."""
     i = int(np.argmax(F))
     if (0 < i < F.size - 1 and i not in kinks and min(F[i - 1], F[i + 1]) > 0.9 * F[i]
             and t[i - 1] < t[i] < t[i + 1]):
@@ -142,6 +159,58 @@ def summarise(stepper) -> dict:
     tc, Fcp = peak(t, Fc, stepper.kinks)
     out.update(F_peak_total=Fp * s.F0, t_peak_total=tp * s.T, F_peak_contact=Fcp * s.F0,
                t_peak_contact=tc * s.T)
+    if s.until == "path":
+        out.update(_path_summary(stepper, rows, events))
+    return out
+
+
+def _path_summary(stepper, rows, events) -> dict:
+    """Pull-off, jumps, extreme compression and the work along a loading path (SI)."""
+    s = stepper.setup
+    t, H, Ft = rows[:, 0], rows[:, 1], rows[:, 6]
+    i_max = int(np.argmax(Ft))
+    i_min = int(np.argmin(Ft))
+    tp, Fp = peak(t, Ft, stepper.kinks)
+    out = {"F_pulloff": Fp * s.F0, "t_pulloff": tp * s.T,
+           "h_pulloff": float(np.interp(tp, t, H)) * s.delta if i_max in range(len(t)) else
+           math.nan,
+           "F_max_compressive": min(Ft[i_min], 0.0) * s.F0 if Ft[i_min] < 0.0 else math.nan}
+    for kind in ("in", "out"):
+        when = [w for w, name in stepper.events if name == f"jump_{kind}"]
+        if when:
+            i = int(np.nonzero(t == when[0])[0][0])
+            out[f"F_jump_{kind}"] = Ft[i] * s.F0
+            out[f"h_jump_{kind}"] = H[i] * s.delta
+    energy = float(np.sum(0.5 * (Ft[1:] + Ft[:-1]) * np.diff(H)))
+    out["energy_dissipated"] = energy * s.F0 * s.delta
+    retract = _last_retraction(stepper, rows)
+    Fr, Hr = np.maximum(Ft[retract:], 0.0), H[retract:]
+    out["work_separation"] = float(np.sum(0.5 * (Fr[1:] + Fr[:-1]) * np.diff(Hr))) * s.F0 * s.delta
+    return out
+
+
+def _last_retraction(stepper, rows) -> int:
+    """First row of the last stretch along which the lift only grows."""
+    H = rows[:, 1]
+    i = len(H) - 1
+    while i > 0 and H[i - 1] <= H[i]:
+        i -= 1
+    return i
+
+
+def _path_groups(scene) -> dict:
+    """Maugis' lambda (a sphere) and the retraction speed in relaxation times."""
+    from ..model.elastic_contact import maugis_lambda
+
+    spectrum = scene.material.spectrum()
+    out = {}
+    if scene.geometry.kind == "sphere":
+        out["maugis_lambda"] = maugis_lambda(scene.geometry.radius, spectrum.G_inf,
+                                             scene.adhesion.sigma_c, scene.adhesion.gamma)
+    speeds = [seg.speed for seg in scene.loading.segments if seg.speed and seg.speed > 0]
+    if speeds and spectrum.relaxation_times:
+        out["speed_relaxation"] = speeds[-1] * max(spectrum.relaxation_times) / \
+            scene.adhesion.delta
     return out
 
 
@@ -152,7 +221,8 @@ def _history(stepper, observers) -> dict:
     rows = rows[keep]
     return {"t": rows[:, 0] * s.T, "h": rows[:, 1] * s.delta, "a": rows[:, 2] * s.L,
             "b": rows[:, 3] * s.L, "gap": rows[:, 4] * s.delta,
-            "F_contact": rows[:, 5] * s.F0, "F_total": rows[:, 6] * s.F0}
+            "F_contact": rows[:, 5] * s.F0, "F_total": rows[:, 6] * s.F0,
+            "segment": rows[:, 7]}
 
 
 def _notes(stepper, scene, estimate, rtol) -> list:
@@ -186,6 +256,8 @@ def _result(scene, setup, ladder_result, observers, wall) -> Result:
         summary.update(analytic.dimensionless_groups(
             spectrum.G_inf, spectrum.eta, scene.adhesion.sigma_c, scene.adhesion.delta,
             getattr(scene.geometry, "radius", math.nan), scene.loading.v))
+    else:
+        summary.update(_path_groups(scene))
     summary.update(error_estimate=float(estimate), observed_order=float(ladder_result.order),
                    n_elements=int(finest.nodes.n), n_steps=len(finest.rows) - 1,
                    wall_time=wall, t_end=float(finest.now.t * setup.T), solver="contact",
@@ -195,5 +267,8 @@ def _result(scene, setup, ladder_result, observers, wall) -> Result:
     analytic_values = analytic.predictions(scene) if setup.indenter.kind != "smooth" else {}
     if setup.indenter.kind != FLAT_EXTERNAL:
         analytic_values.update({k: math.nan for k in ("seed_linearised_t_detach",)})
+    # A flat punch's pull keeps the reduced description every flat-punch solver gives.
+    problem = (Problem.from_scene(scene) if scene.loading.kind == "constant_velocity"
+               else setup)
     return Result.build(summary, analytic_values, _history(finest, observers), notes=notes,
-                        complete=not getattr(finest, "interrupted", False), problem=setup)
+                        complete=not getattr(finest, "interrupted", False), problem=problem)

@@ -12,31 +12,36 @@ from . import contact_phases as phases
 from . import contact_state as st
 
 
-def solve(stepper, step, H_guess, force_residual):
+def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
     """The evaluation whose lift balances ``force_residual`` and whose phase conditions hold.
 
     Where the phase fixes its edges explicitly (bonded, pinned, apart) this is Newton on the
     lift alone. Elsewhere the phase's own root finding runs inside a bracketed search on the
     lift; a flat punch's edge is first tried held (the edge sticks while the gap stays below
-    delta), and that lift starts the search if it does not."""
+    delta), and that lift starts the search if it does not. ``H_travel`` is the lift's
+    expected travel over the step (it sizes the search's first trial)."""
     now = step.now
     explicit = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.APART: phases.apart}
     scale = _force_scale(stepper, now)
+    # Finite differences on the lift's own scale over the step: a viscous solid's force is
+    # nonlinear in the lift on the scale of the rate it implies (a unit-sized difference put
+    # the slope 6x off in a 3 ns first step, and Newton stalled).
+    H_scale = np.array([max(H_travel, 1e-6 * abs(now.H), 1e-12)])
     if now.phase in explicit:
         build = explicit[now.phase]
         out = _newton(lambda z: _with_force(build(step, z[0]), force_residual),
-                      np.array([H_guess]), np.array([max(abs(now.H), 1.0)]), scale)
+                      np.array([H_guess]), H_scale, scale)
         if out is None:
             raise phases.Lost("balance")
         return out[0]
     if now.phase == st.CONTACT_PHASE and stepper.setup.flat:
         held = _newton(lambda z: _with_force(_stick(step, z[0]), force_residual),
-                       np.array([H_guess]), np.array([max(abs(now.H), 1.0)]), scale)
+                       np.array([H_guess]), H_scale, scale)
         if held is not None:
             if held[0].gap <= 1.0:
                 return held[0]
             H_guess = held[0].H
-    return _nested(stepper, step, H_guess, force_residual)
+    return _nested(stepper, step, H_guess, force_residual, H_travel)
 
 
 def _with_force(ev, force_residual):
@@ -52,7 +57,7 @@ def _force_scale(stepper, now):
     return np.array([max(1.0, abs(now.F_total), machine * abs(now.H))])
 
 
-def _nested(stepper, step, H_guess, force_residual):
+def _nested(stepper, step, H_guess, force_residual, H_travel):
     """The phase's root finding inside, the lift outside (bracketed, nearest ``H_guess``);
     a lift at which the phase has no state counts as beyond the search's domain."""
     cache = {}
@@ -70,7 +75,10 @@ def _nested(stepper, step, H_guess, force_residual):
         r0 = residual(H_guess)
     if math.isnan(r0):
         raise phases.Lost("balance")
-    H = phases._root(residual, H_guess, r0, H_guess + 1e-9 * max(abs(H_guess), 1.0),
+    # The first trial is a small part of the lift's travel over the step: a short step of a
+    # viscous solid balances only in a narrow window of lifts.
+    probe = max(1e-3 * H_travel, 1e-12 * max(abs(H_guess), 1.0))
+    H = phases._root(residual, H_guess, r0, H_guess + min(probe, 1e-9 * max(abs(H_guess), 1.0)),
                      -math.inf, math.inf)
     if H is None:
         raise phases.Lost("balance")

@@ -233,7 +233,9 @@ def smooth_contact(step, H, guess_alpha, guess_beta):
     now = step.now
     ind = step.s.setup.indenter
     law = step.s.setup.law
-    if law.c == 0.0 and not law.maxwell:
+    if (law.c == 0.0 and not law.maxwell) or (step.jump and law.maxwell):
+        # No history (elastic), or none that can act in zero time (a jump of a solid with
+        # an instantaneous modulus): the edge condition fixes the zone end.
         return elastic_contact(step, H, guess_alpha)
     held = zone_end(step, H, now.alpha, guess_beta)
     ell = math.sqrt(max((held.beta - now.alpha) * (held.beta + now.alpha), 0.0))

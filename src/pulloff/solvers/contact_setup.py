@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..kernels import contact as K
+
 #: Kinds of indenter the stepper distinguishes.
 FLAT_EXTERNAL, FLAT_INTERNAL, SMOOTH = "flat_external", "flat_internal", "smooth"
 
@@ -79,21 +81,36 @@ class Law:
 @dataclass(frozen=True)
 class Indenter:
     """``f = A_f xi^n``, ``g = C xi^n`` in units of ``delta`` over ``xi`` in ``L`` (a flat punch:
-    ``C = 0`` with its face ending at ``xi = 1``)."""
+    ``C = 0`` with its face ending at ``xi = 1``), or a tabulated tip as ramps
+    ``f = sum_j jumps_j (xi - knots_j)_+``."""
 
     kind: str
     A_f: float = 0.0
     C: float = 0.0
     n: float = 0.0
+    knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    jumps: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def table(self):
+        return self.knots, self.jumps
 
     def f(self, xi):
+        if self.knots.size:
+            return K.table_f(self.knots, self.jumps, float(xi))
         return self.A_f * xi ** self.n if self.A_f else 0.0
 
     def g(self, xi):
-        return self.C * xi ** self.n if self.C else 0.0
+        if self.knots.size:
+            if np.ndim(xi):
+                return np.array([K.table_g(self.knots, self.jumps, float(x)) for x in xi])
+            return K.table_g(self.knots, self.jumps, float(xi))
+        return self.C * np.abs(xi) ** self.n if self.C else 0.0 * xi
 
     def g_integral(self, alpha):
         """``int_0^alpha g dxi``."""
+        if self.knots.size:
+            return K.table_g_integral(self.knots, self.jumps, alpha)
         return self.C * alpha ** (self.n + 1.0) / (self.n + 1.0) if self.C else 0.0
 
 
@@ -138,11 +155,27 @@ def _indenter(geometry, delta):
     if geometry.kind == "flat_punch":
         kind = FLAT_INTERNAL if geometry.cohesive_zone == "internal" else FLAT_EXTERNAL
         return geometry.radius, Indenter(kind)
+    if geometry.kind == "profile":
+        knots, jumps = geometry.ramps()
+        L = _where_f_reaches(knots, jumps, delta)
+        return L, Indenter(SMOOTH, knots=knots / L, jumps=jumps * L / delta)
     A, n = geometry.power_law()
     L = (delta / A) ** (1.0 / n)  # f(L) = delta
     from ..model.geometry import kappa_n
 
     return L, Indenter(SMOOTH, A * L ** n / delta, kappa_n(n) * A * L ** n / delta, n)
+
+
+def _where_f_reaches(knots, jumps, height):
+    """The radius where a tip written as ramps rises by ``height`` (its last slope continues
+    beyond the table)."""
+    from scipy.optimize import brentq
+
+    f = lambda r: float(np.maximum(r - knots, 0.0) @ jumps) - height  # noqa: E731
+    hi = max(float(knots[-1]) if knots.size else 1.0, 1e-300)
+    while f(hi) < 0.0:
+        hi *= 2.0
+    return brentq(f, 0.0, hi, xtol=1e-14 * hi)
 
 
 def _drives(loading, delta, T, F0):

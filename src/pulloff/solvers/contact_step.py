@@ -129,6 +129,11 @@ class Step:
         """Line load of a contact element at ``xi`` at the end of the step."""
         law = self.s.setup.law
         G = self.s.setup.indenter.g(xi)
+        if law.maxwell and self.jump and not self.s.setup.flat:
+            # In a jump the dashpots do not move: an element the contact reaches keeps the
+            # free state it had (virgin: none), and meets the indenter with the glassy modulus.
+            E = law.V @ self.s.free_modes_at(xi)
+            return law.kappa_instant * (H_new + G) - float(np.dot(law.kappa_arms, E))
         if law.maxwell:
             memory = self.s.contact_memory(xi, self.now.t + self.dt)
             return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
@@ -178,7 +183,7 @@ class Step:
         mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
         stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf)
         m = K.evaluate_step(mesh, self.law, stepw, paths, sc, lo, hi, alpha, beta, nodes.n,
-                            out, res)
+                            s.setup.indenter.table, out, res)
         ev = Evaluation(alpha, beta, H_new, Hdot, res[K.R_GAP], res[K.R_EDGE_LOAD],
                         res[K.R_EDGE_FREE_U], res[K.R_F_CONTACT], res[K.R_F_TOTAL],
                         res[K.R_CENTRE_U], lo, hi, out[1][:m], out[2][:m], Hf)

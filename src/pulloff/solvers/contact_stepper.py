@@ -35,6 +35,8 @@ _NODES_PER_ZONE = 16.0
 #: Elements placed per step where the zone end enters virgin solid (evenly in angle).
 ENTRY_NODES = 4
 #: Steps a run may take (per level).
+#: A step that went further than this many targets (``1/n`` of the measure) is redone.
+REDO_MEASURE = 4.0
 MAX_STEPS = 40_000
 
 
@@ -141,6 +143,17 @@ class Stepper:
         mem = nodes.D[idx, :m] * np.exp(-(t - nodes.tj[idx])[:, None] / law.tau_arms)
         return np.array([np.interp(xi, nodes.xi[idx], mem[:, i]) for i in range(m)])
 
+    def free_modes_at(self, x):
+        """Modes of a free element at ``x`` now: interpolated between the free elements around
+        it (zero in virgin solid, beyond every element)."""
+        nodes = self.nodes
+        law = self.setup.law
+        idx = np.nonzero(nodes.status[:nodes.n] == st.FREE)[0]
+        if idx.size == 0 or x > nodes.xi[idx[-1]]:
+            return np.zeros(law.n_modes)
+        xs = nodes.xi[idx]
+        return np.array([np.interp(x, xs, nodes.Y[idx, k]) for k in range(law.n_modes)])
+
     def contact_memory(self, xi, t):
         """``sum_i kappa_i D_i e^{-(t - tj)/tau_i}``: the arms' memory in the contact load."""
         return float(np.dot(self.setup.law.kappa_arms, self.contact_memory_arms(xi, t)))
@@ -206,16 +219,20 @@ class Stepper:
         self.F_range = max(self.F_range, abs(now.F_total))
         if before is not None and now.t > before.t:
             dt_prev = now.t - before.t
-            scale = max(1.0, now.beta)
-            rate = (1.0 / self.t_scale
-                    + (abs(now.alpha - before.alpha) + abs(now.beta - before.beta)) / scale
-                    / dt_prev
-                    + abs(now.H - before.H) / self.H_range / dt_prev
-                    + abs(now.F_total - before.F_total) / self.F_range / dt_prev)
+            rate = self._measure(before, now, dt_prev) / dt_prev
             dt = min(1.0 / (self.n * rate), 2.0 * dt_prev)
         elif self.last_dt is not None:
             dt = min(dt, self.last_dt)
         return min(dt, t_end - now.t, self._segment_left())
+
+    def _measure(self, a, b, dt) -> float:
+        """How far a step of length ``dt`` went from state ``a`` to ``b``: time in ``t_scale``,
+        the edges' travel in the zone's size, the lift's and the force's in their ranges."""
+        scale = max(1.0, b.beta)
+        return (dt / self.t_scale
+                + (abs(b.alpha - a.alpha) + abs(b.beta - a.beta)) / scale
+                + abs(b.H - a.H) / self.H_range
+                + abs(b.F_total - a.F_total) / self.F_range)
 
     def _segment_left(self) -> float:
         name, value = self.drive.end
@@ -226,17 +243,28 @@ class Stepper:
     def _advance(self, dt) -> None:
         if self.now.phase == st.ZONE and self._separates_within(dt):
             return
-        step = self.make_step(dt)
-        try:
-            ev = self.solve(step)
-        except phases.Lost as lost:
-            self._branch_end(dt, lost.what)
-            return
+        for _ in range(8):
+            step = self.make_step(dt)
+            try:
+                ev = self.solve(step)
+            except phases.Lost as lost:
+                self._branch_end(dt, lost.what)
+                return
+            # A step sized from the last one can overshoot where the motion starts at once
+            # (a crack leaving its onset): such a step is redone shorter.
+            went = self._measure(self.now, ev, dt) * self.n
+            if went <= REDO_MEASURE:
+                break
+            dt *= 0.5 / went
         event = self.crossed(ev)
         if event is None:
             self.commit(step, ev)
             return
-        step, ev = self._locate(event, dt)
+        try:
+            step, ev = self._locate(event, dt)
+        except phases.Lost as lost:
+            self._branch_end(dt, lost.what)
+            return
         self.commit(step, ev)
         self.transition(event)
 
@@ -308,10 +336,15 @@ class Stepper:
 
             def force_residual(ev):
                 return target - ev.F_total
-        guess = now.H
+        # After an event the paths restart; the lift's rate still carries over (a viscous
+        # solid's force follows the rate: a short step tolerates only a narrow lift).
+        rate = now.Hdot if math.isfinite(now.Hdot) else 0.0
+        if rate == 0.0 and s.machine is not None and drive.kind == "speed":
+            rate = drive.rate  # at rest: the driver's speed sizes the lift's first move
         if self.before is not None and now.t > self.before.t:
-            guess = now.H + (now.H - self.before.H) * step.dt / (now.t - self.before.t)
-        return balance.solve(self, step, guess, force_residual)
+            rate = (now.H - self.before.H) / (now.t - self.before.t)
+        guess = now.H + rate * step.dt
+        return balance.solve(self, step, guess, force_residual, abs(rate) * step.dt)
 
     # --- events ------------------------------------------------------------------------------
     def event_values(self, x) -> dict:
@@ -328,6 +361,7 @@ class Stepper:
             if not self.setup.flat:  # a flat punch's face does not re-bond
                 out["touch"] = -centre_gap
             out["separation"] = centre_gap - 1.0
+        out.update(self._knot_values(x))
         name, value = self.drive.end
         t = x.t if isinstance(x, st.Instant) else self.now.t + x.dt
         if name == "time":
@@ -335,6 +369,30 @@ class Stepper:
         elif name in ("lift", "force"):
             current = x.H if name == "lift" else x.F_total
             out["end"] = self.now.segment_sign * (current - value)
+        return out
+
+    def _knot_values(self, x) -> dict:
+        """A tabulated tip's force has a corner wherever an edge crosses a knot (the
+        interpolant's slope jumps there): each crossing is an event, so that no step straddles
+        a corner and a peak at one is sampled exactly. The knots next to each edge are those
+        of the current instant, whichever way the edge moves."""
+        knots = self.setup.indenter.knots
+        if not knots.size or self.now.phase not in (st.CONTACT_PHASE, st.ZONE):
+            return {}
+        out = {}
+        for name in ("alpha", "beta"):
+            e0, e1 = getattr(self.now, name), getattr(x, name)
+            if name == "alpha" and (self.now.phase != st.CONTACT_PHASE or e0 <= 0.0):
+                continue
+            if not (e0 > 0.0 and math.isfinite(e1)):
+                continue
+            margin = 1e-12 * e0
+            j = int(np.searchsorted(knots, e0 + margin, side="right"))
+            if j < knots.size:
+                out[f"knot_{name}_up"] = e1 - knots[j]
+            j = int(np.searchsorted(knots, e0 - margin, side="left")) - 1
+            if j >= 1:  # the knot at the centre is no corner of a moving edge
+                out[f"knot_{name}_down"] = knots[j] - e1
         return out
 
     def crossed(self, ev):
@@ -364,6 +422,7 @@ class Stepper:
 
         v1 = value(dt)
         lo, hi, f_lo, f_hi = 0.0, dt, v0, v1
+        last_lost = None
         for _ in range(100):
             # Illinois-flavoured regula falsi, falling back to bisection.
             d = hi - f_hi * (hi - lo) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * (lo + hi)
@@ -371,8 +430,9 @@ class Stepper:
                 d = 0.5 * (lo + hi)
             try:
                 f = value(d)
-            except phases.Lost:
+            except phases.Lost as lost:
                 hi, f_hi = d, abs(f_hi)  # the branch ends before: the event is earlier
+                last_lost = lost
                 continue
             if f >= 0.0:
                 hi, f_hi = d, f
@@ -382,7 +442,11 @@ class Stepper:
                 f_hi *= 0.5
             if abs(f) <= 1e-13 or hi - lo <= 1e-15 * max(self.now.t + dt, self.t_scale):
                 break
-        return cache[hi] if hi in cache else cache[d]
+        if hi in cache:
+            return cache[hi]
+        if d in cache:
+            return cache[d]
+        raise last_lost  # the branch ends before any event: not one to land on
 
     def _branch_end(self, dt, what) -> None:
         """No state of the phase at the end of the step. If there is none even a moment
@@ -498,6 +562,12 @@ class Stepper:
             now.phase = st.CONTACT_PHASE
             return self._physical_end("onset")
         if what == "strength":
+            # The bond's last point: the limit a -> 0 (the step landed within 1e-6 of it),
+            # where the face pulls at sigma_c alone and the contact carries nothing.
+            now.alpha, now.F_contact = 0.0, 0.0
+            now.F_total = math.pi * now.beta ** 2
+            self.rows[-1] = (now.t, now.H, 0.0, now.beta, now.gap, 0.0, now.F_total,
+                             self.rows[-1][7])
             self.events.append((now.t, "onset"))
             self._release_all()
             now.phase = st.ZONE
@@ -526,6 +596,8 @@ class Stepper:
             return self._touch()
         if what == "end":
             return self._next_segment()
+        if what.startswith("knot_"):
+            return
         raise RuntimeError(f"unknown event {what!r}")  # a bug, not input
 
     def _growing_zone(self) -> bool:

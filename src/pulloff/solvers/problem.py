@@ -107,4 +107,5 @@ def si_history(problem: "Problem", t, gap) -> dict:
         "gap": gap * problem.delta,
         "F_contact": problem.contact_force(t),
         "F_total": problem.total_force(t),
+        "segment": np.zeros(np.shape(t)),  # a pull is one segment
     }

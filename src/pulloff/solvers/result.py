@@ -41,6 +41,9 @@ class Result:
             raise KeyError(f"summary quantities not in the output table: {sorted(unknown)}")
         an = {q.name: analytic.get(q.name, "" if q.text else math.nan)
               for q in outputs.of_group("analytic")}
+        # A pull has one segment: its history may leave that column out.
+        history = dict(history)
+        history.setdefault("segment", np.zeros(np.shape(history["t"])))
         hist = {name: np.asarray(history[name], dtype=float) for name in outputs.units("history")}
         if not full["notes"]:
             full["notes"] = "; ".join(rest.get("notes", ()))
