@@ -59,7 +59,10 @@ def format_table(record: dict, title: str | None = None) -> str:
         lines.append(title)
     lines.append(f"  model: history={s.get('history', 'exact')}   alpha = {_fmt(s['alpha'])}   "
                  f"chi = {_fmt(s['chi'])}   V = {_fmt(s['V'])}   solver: {s.get('solver', '?')}")
-    if not record.get("complete", True):
+    if "F_pulloff" in s and isinstance(s["F_pulloff"], float) and math.isfinite(s["F_pulloff"]):
+        lines[-1] = f"  model: path   solver: {s.get('solver', '?')}"
+        lines.extend(_path_lines(record))
+    elif not record.get("complete", True):
         lines.append(f"  INCOMPLETE: interrupted at t = {_fmt(s['t_end'], 's')}; the history "
                      f"holds what was computed until then")
     elif not s["detached"]:
@@ -98,7 +101,8 @@ def format_table(record: dict, title: str | None = None) -> str:
                             s["F_total_detach"]))
         for label, value, unit, ref in compare:
             lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
-    if s.get("until") == "separation" and record.get("complete", True):
+    if (s.get("until") == "separation" and record.get("complete", True)
+            and not math.isfinite(s.get("F_pulloff", math.nan))):
         lines.append("  past the onset (model.until = separation)")
         F_on = s["F_total_detach"]
         rows = [
@@ -123,6 +127,45 @@ def format_table(record: dict, title: str | None = None) -> str:
                  f"wall time {s['wall_time'] * 1e3:.1f} ms")
     return "\n".join(lines)
 
+
+
+def _path_lines(record) -> list[str]:
+    """The summary of a loading path: pull-off, jumps, energy, and the closed forms (elastic
+    solids) beside them."""
+    s, an = record["summary"], record["analytic"]
+    lines = []
+    if not record.get("complete", True):
+        lines.append(f"  INCOMPLETE: interrupted at t = {_fmt(s['t_end'], 's')}")
+    rows = [
+        ("pull-off F_pulloff", f"{_fmt(s.get('F_pulloff'), 'N')} at h = "
+                               f"{_fmt(s.get('h_pulloff'), 'm')}"),
+        ("most compressive F_total", _fmt(s.get("F_max_compressive"), "N")),
+        ("jump in: F, h", f"{_fmt(s.get('F_jump_in'), 'N')}, {_fmt(s.get('h_jump_in'), 'm')}"),
+        ("jump out: F, h", f"{_fmt(s.get('F_jump_out'), 'N')}, "
+                           f"{_fmt(s.get('h_jump_out'), 'm')}"),
+        ("energy dissipated", _fmt(s.get("energy_dissipated"), "J")),
+        ("work of separation", _fmt(s.get("work_separation"), "J")),
+        ("Maugis lambda", _fmt(s.get("maugis_lambda"))),
+        ("error estimate (relative)", _fmt(s.get("error_estimate"))),
+    ]
+    lines.append("  simulation")
+    for label, text in rows:
+        lines.append(f"    {label:<28} {text:>34}")
+    compare = [
+        ("MDR-Dugdale F, load control", "mdr_dugdale_F_pulloff_load", "F_pulloff"),
+        ("MDR-Dugdale F, displ. control", "mdr_dugdale_F_pulloff_displacement", "F_jump_out"),
+        ("Maugis-Dugdale F, load control", "maugis_F_pulloff_load", "F_pulloff"),
+        ("Maugis-Dugdale F, displ. control", "maugis_F_pulloff_displacement", "F_jump_out"),
+        ("JKR F, load control", "jkr_F_pulloff_load", "F_pulloff"),
+    ]
+    shown = [(label, an.get(key), s.get(ref), ref) for label, key, ref in compare
+             if isinstance(an.get(key), float) and math.isfinite(an.get(key))]
+    if shown:
+        lines.append("  closed forms (elastic)                 value   vs simulation")
+        for label, value, ref, name in shown:
+            lines.append(f"    {label:<34} {_fmt(value, 'N'):>14}   {_rel(value, ref):>10}"
+                         f" ({name})")
+    return lines
 
 
 def _short(value) -> str:

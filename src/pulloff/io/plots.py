@@ -34,9 +34,12 @@ def _legend(ax) -> None:
 def plot_history(record: dict, path, title: str | None = None) -> Path:
     """Force (with the closed forms, the onset and the peak), cohesive-zone width
     ``(b - a)/a`` with the contact edge, and gap histories; a driver/spring panel for a
-    compliant machine. Saves a PNG at ``path``."""
+    compliant machine; a loading path's force-displacement loop instead (:func:`plot_path`).
+    Saves a PNG at ``path``."""
     import numpy as np
 
+    if _get(_scene(record), "loading", "kind") == "path":
+        return plot_path(record, path, title)
     h = record["history"]
     s = record["summary"]
     an = record["analytic"]
@@ -128,6 +131,52 @@ def plot_history(record: dict, path, title: str | None = None) -> Path:
     axes[-1].set_xlabel("time [ms]")
     if title:
         fig.suptitle(title, fontsize=10)
+    return _save(fig, path)
+
+
+#: Closed forms of a path drawn as levels on the loop: key, label, colour, style.
+_PATH_FORMS = (
+    ("mdr_dugdale_F_pulloff_load", "MDR-Dugdale pull-off, load control", "C3", ":"),
+    ("mdr_dugdale_F_pulloff_displacement", "MDR-Dugdale pull-off, displacement control",
+     "C5", "-."),
+    ("jkr_F_pulloff_load", "JKR pull-off, load control", "C7", (0, (6, 2))),
+)
+
+
+def plot_path(record: dict, path, title: str | None = None) -> Path:
+    """A loading path: force against lift (the loop, one colour per segment, the pull-off and
+    the elastic closed forms marked), and the contact edge ``a`` and zone end ``b`` against
+    time."""
+    import numpy as np
+
+    h, s, an = record["history"], record["summary"], record["analytic"]
+    fig, (ax_l, ax_e) = plt.subplots(2, 1, figsize=(9.0, 7.2), constrained_layout=True)
+    lift_nm = np.asarray(h["h"], float) * 1e9
+    force_uN = np.asarray(h["F_total"], float) * 1e6
+    segment = np.asarray(h.get("segment", np.zeros(lift_nm.size)), int)
+    for k in np.unique(segment):
+        rows = np.nonzero(segment == k)[0]
+        # Share the row where one segment hands over, so the loop has no holes.
+        rows = np.append(rows, rows[-1] + 1) if rows[-1] + 1 < lift_nm.size else rows
+        ax_l.plot(lift_nm[rows], force_uN[rows], color=f"C{k % 10}", label=f"segment {k}")
+    if _finite(s.get("F_pulloff")):
+        ax_l.plot([s["h_pulloff"] * 1e9], [s["F_pulloff"] * 1e6], "v", color="k",
+                  label="pull-off (simulation)")
+    for key, label, colour, style in _PATH_FORMS:
+        if _finite(an.get(key)):
+            ax_l.axhline(an[key] * 1e6, color=colour, ls=style, lw=1.0, label=label)
+    ax_l.set_xlabel("lift h [nm] (negative: pressed in)")
+    ax_l.set_ylabel("F_total [uN] (tension > 0)")
+    ax_l.grid(alpha=0.3)
+    _legend(ax_l)
+    t_ms = np.asarray(h["t"], float) * 1e3
+    ax_e.plot(t_ms, np.asarray(h["a"], float) * 1e6, color="C0", label="contact edge a")
+    ax_e.plot(t_ms, np.asarray(h["b"], float) * 1e6, color="C1", ls="--", label="zone end b")
+    ax_e.set_xlabel("time [ms]")
+    ax_e.set_ylabel("radius [um]")
+    ax_e.grid(alpha=0.3)
+    _legend(ax_e)
+    fig.suptitle(title or s.get("name", "") or "loading path", fontsize=11)
     return _save(fig, path)
 
 

@@ -617,3 +617,35 @@ def predictions(scene) -> dict:
 def _elastic_onset(G, sigma_c, delta, a, internal):
     return (elastic_internal_onset(G, sigma_c, delta, a) if internal
             else elastic_mdr_dugdale(G, sigma_c, delta, a))
+
+
+PATH_KEYS = ("mdr_dugdale_F_pulloff_load", "mdr_dugdale_F_pulloff_displacement",
+             "jkr_F_pulloff_load", "maugis_F_pulloff_load", "maugis_F_pulloff_displacement")
+
+
+def path_predictions(scene) -> dict:
+    """The closed forms beside a smooth indenter's path on an elastic solid, SI, keyed as in
+    :mod:`pulloff.model.outputs` (nan where they do not apply: a solid with memory, a flat
+    punch)."""
+    from . import elastic_contact as ec
+
+    out = dict.fromkeys(PATH_KEYS, math.nan)
+    geometry, spectrum = scene.geometry, scene.material.spectrum()
+    if geometry.kind == "flat_punch" or spectrum.relaxation_times:
+        return out
+    G = spectrum.G_inf
+    sigma_c, delta, gamma = scene.adhesion.sigma_c, scene.adhesion.delta, scene.adhesion.gamma
+    if geometry.kind == "profile":
+        profile = ec.mdr_profile_tabulated(np.asarray(geometry.r), np.asarray(geometry.f))
+    else:
+        profile = ec.mdr_profile_power_law(*geometry.power_law())
+    for control in ("load", "displacement"):
+        out[f"mdr_dugdale_F_pulloff_{control}"] = ec.mdr_dugdale_pulloff(
+            profile, G, sigma_c=sigma_c, delta=delta, control=control).F
+    out["jkr_F_pulloff_load"] = ec.jkr_pulloff(profile, 4.0 * G, gamma, "load").F
+    if geometry.kind == "sphere":
+        for control in ("load", "displacement"):
+            out[f"maugis_F_pulloff_{control}"] = ec.maugis_pulloff_force(
+                geometry.radius, G, sigma_c, gamma, control)
+    return out
+

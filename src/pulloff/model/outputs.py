@@ -21,6 +21,7 @@ WHERE = {
     "path": "scenes with a loading path (loading.kind = path)",
     "jump": "paths where the contact is gained or lost by a jump",
     "sphere": "spheres",
+    "elastic_path": "elastic solids under a smooth indenter on a loading path",
 }
 
 
@@ -116,6 +117,19 @@ OUTPUTS = (
        "maxwell"),
     _a("elastic_instant_F_total", "N", "elastic F_total with the instantaneous modulus",
        "maxwell"),
+    _a("mdr_dugdale_F_pulloff_load", "N", "elastic MDR-Dugdale pull-off under load control, "
+                                          "from the equilibrium curve of the indenter's own "
+                                          "profile (an independent semi-analytic solution)",
+       "elastic_path"),
+    _a("mdr_dugdale_F_pulloff_displacement", "N", "the same under displacement control (where "
+                                                  "a rigid lift leaves the curve)",
+       "elastic_path"),
+    _a("jkr_F_pulloff_load", "N", "JKR pull-off under load control (the limit of an infinitely "
+                                  "strong, short-ranged adhesion)", "elastic_path"),
+    _a("maugis_F_pulloff_load", "N", "Maugis-Dugdale pull-off of a sphere, load control",
+       "sphere"),
+    _a("maugis_F_pulloff_displacement", "N", "Maugis-Dugdale pull-off of a sphere, "
+                                             "displacement control", "sphere"),
 )
 
 BY_NAME = {q.name: q for q in OUTPUTS}

@@ -223,6 +223,8 @@ class Stepper:
             dt = min(1.0 / (self.n * rate), 2.0 * dt_prev)
         elif self.last_dt is not None:
             dt = min(dt, self.last_dt)
+        # A step must move the clock: below its resolution the run would stand still.
+        dt = max(dt, 64 * np.finfo(float).eps * max(abs(now.t), self.t_scale))
         return min(dt, t_end - now.t, self._segment_left())
 
     def _measure(self, a, b, dt) -> float:
@@ -253,9 +255,10 @@ class Stepper:
             # A step sized from the last one can overshoot where the motion starts at once
             # (a crack leaving its onset): such a step is redone shorter.
             went = self._measure(self.now, ev, dt) * self.n
-            if went <= REDO_MEASURE:
+            floor = 64 * np.finfo(float).eps * max(abs(self.now.t), self.t_scale)
+            if went <= REDO_MEASURE or dt <= 2 * floor:
                 break
-            dt *= 0.5 / went
+            dt = max(dt * 0.5 / went, floor)
         event = self.crossed(ev)
         if event is None:
             self.commit(step, ev)
@@ -511,8 +514,17 @@ class Stepper:
         nodes.t_last[lo:hi] = t1
         status[released] = st.FREE
         if not step.fresh:  # an elastic solid's evaluations place their own elements
+            law = self.setup.law
             for xv, Yv in zip(ev.xi[ev.virtual], ev.Y[ev.virtual]):
-                nodes.insert(float(xv), Yv, st.FREE, t_last=t1)
+                i = nodes.insert(float(xv), Yv, st.FREE, t_last=t1)
+                if 0.0 < xv <= ev.alpha:
+                    # New in the step and already inside the contact (a jump in, or an edge
+                    # overtaking the zone's new elements): it joins at the step's end, with
+                    # the dashpot state it has (virgin in a jump: the glassy response).
+                    nodes.status[i], nodes.tj[i] = st.CONTACT, t1
+                    if law.maxwell:
+                        nodes.D[i, :law.tau_arms.size] = (law.V @ Yv[:law.n_modes] - ev.Hf
+                                                          - self.setup.indenter.g(xv))
         self.before = self.now
         self.last_dt = step.dt
         self.now = self.now.copy(t=t1, H=ev.H, Hdot=ev.Hdot, alpha=ev.alpha, beta=ev.beta,
@@ -585,6 +597,9 @@ class Stepper:
             if what == "zone" and self._growing_zone():
                 self._touch()
                 return self._jump("in")
+            if what == "balance" and now.alpha > 0.0:
+                # No equilibrium under the spring or the force: the indenter snaps off.
+                self.events.append((now.t, "jump_out"))
             now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
             self.events.append((now.t, "separated"))
             self._row(now)
@@ -631,9 +646,22 @@ class Stepper:
         self.events.append((now.t, f"jump_{kind}"))
         self.kinks.add(len(self.rows) - 1)
         self.commit(step, ev)
+        if self.setup.law.maxwell and self.now.alpha > 0.0:
+            self._recount_forces()
         self.kinks.add(len(self.rows) - 1)
         self.phase_row = len(self.rows) - 1
         self.before = None
+
+    def _recount_forces(self) -> None:
+        """The forces of the instant again, now that the elements a jump brought into contact
+        remember how they joined (the jump's own evaluation counted them as relaxed)."""
+        step = Step(self, self.now, 1e-12 * self.t_scale, None)
+        now = self.now
+        ev = step.evaluate(now.alpha, now.beta, now.H)
+        now.F_contact, now.F_total = ev.F_contact, ev.F_total
+        row = list(self.rows[-1])
+        row[5], row[6] = now.F_contact, now.F_total
+        self.rows[-1] = tuple(row)
 
     def _touch(self) -> None:
         """The surface meets the indenter at the centre: contact begins there."""
