@@ -83,11 +83,10 @@ def test_kelvin_voigt_crack_grows_at_finite_speed_past_a_higher_peak(kv_levels):
 def test_kelvin_voigt_separation_converges_to_the_independent_reference(kv_levels):
     """Against pulloff.references.edge (history quadrature, a second method; its values
     carry ~1e-10 error). Measured n = 16, 32, 64: differences between levels fall at orders
-    3.1-4 (to 1.7e-6 of t_separation at 32 -> 64; at 128 they stall near 1e-8, the root
-    finders' floor); the converged values differ from the
-    reference by 3.1e-6 (t_separation) and 9.5e-6 (F_peak_total), more than either method's
-    own estimate: an unexplained offset between the two discretisations, reported in the
-    README's known issues rather than hidden here."""
+    3.1-4 (at 128 they stall near 1e-8, the root finders' floor). The fixed level n = 64
+    differs from the reference by 3.1e-6 (t_separation) and 9.5e-6 (F_peak_total), more than
+    its level differences suggest; the solver's controlled result (rtol 1e-3) is off by 8.7e-7
+    and 5e-9. The bands below are those measured offsets, not the level differences."""
     ref = REFERENCE["separation_kv"]
     names = ("t_detach", "F_total_detach", "t_separation", "F_peak_total")
     values = np.array([[kv_levels[n][1][k] for k in names] for n in LEVELS])

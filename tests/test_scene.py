@@ -314,3 +314,11 @@ def test_round_trip_hypothesis(radius, G, eta, sigma_c, delta, v, h0, rtol, pair
     again = parse_scene(yaml.load(scene_to_yaml(s), Loader=SceneLoader))
     assert again == s
     assert scene_to_yaml(again) == scene_to_yaml(s)
+
+
+def test_readme_lists_every_output_from_the_table():
+    from pulloff.model import outputs
+
+    text = (ROOT / "README.md").read_text()
+    block = text.split("<!-- outputs:begin -->\n", 1)[1].split("\n<!-- outputs:end -->", 1)[0]
+    assert block == outputs.markdown()

@@ -51,6 +51,7 @@ def _cmd_run(args) -> int:
         with h5io.atomic_file(out, key) as f:
             # A fixed-step run streams its history into the file while it runs.
             stream = h5io.HistoryStream(f) if scene.numerics.steps is not None else None
+            _compile_notice(args)
             result = solvers.simulate(scene, progress=_progress(args), stream=stream)
             record = h5io.result_to_record(result, scene_to_yaml(scene))
             h5io.fill(f, record, history_streamed=result.history_streamed)
@@ -99,6 +100,15 @@ def _cmd_sweep(args) -> int:
     print(report.format_sweep(result))
     print(f"  {time.perf_counter() - start:.1f} s; wrote {out}")
     return 0
+
+
+def _compile_notice(args) -> None:
+    """Say once, before a first run's long silence, that the kernels are being compiled."""
+    from .kernels import cache_is_warm
+
+    if not getattr(args, "quiet", False) and not cache_is_warm():
+        print("pulloff: compiling the numba kernels for this machine (first run only, "
+              "10-15 s)", file=sys.stderr, flush=True)
 
 
 def _show_progress(args) -> bool:
