@@ -81,15 +81,17 @@ def test_load_rejects_foreign_files(tmp_path):
 
 
 #: Configs whose full run takes tens of seconds (see benchmarks/): here up to their onset.
-SLOW_CONFIGS = {"compliant_machine.yaml": ["--set", "model.until=detach"],
-                "prony_external.yaml": ["--set", "model.until=detach"],
+SLOW_CONFIGS = {"prony_external.yaml": ["--set", "model.until=detach"],
                 "tip_profile.yaml": ["--set", "numerics.rtol=1e-2"],
                 "sphere_force_control.yaml": ["--set", "numerics.rtol=1e-2"]}
+#: Configs run in full by their own tests (here they would only repeat them).
+RUN_ELSEWHERE = {"sphere_force_control.yaml": "tests/test_paths.py"}
 #: Configs whose figure is drawn and re-drawn from the file (one of each kind of figure).
 PLOTTED = {"seed_flat_punch.yaml", "separation_kv.yaml", "sphere_elastic.yaml"}
 
 
-@pytest.mark.parametrize("config", sorted(p.name for p in CONFIGS.glob("*.yaml")))
+@pytest.mark.parametrize("config", sorted(p.name for p in CONFIGS.glob("*.yaml")
+                                           if p.name not in RUN_ELSEWHERE))
 def test_cli_run_show_plot_on_every_shipped_config(tmp_path, capsys, config):
     out = tmp_path / "run.h5"
     plotted = config in PLOTTED

@@ -66,11 +66,10 @@ def test_elastic_sphere_matches_maugis_dugdale(lam):
 
 
 def test_force_control_pulls_off_at_the_load_controlled_force():
-    """Pulled by force, the sphere comes off at the fold of the curve: Maugis-Dugdale's
-    load-controlled pull-off (measured 5e-12), by a jump."""
-    res = run(1.0, "force")
-    load = ec.maugis_pulloff_force(R, G, sigma_for(1.0), GAMMA, "load")
-    assert res.F_pulloff == pytest.approx(load, rel=1e-4)
+    """sphere_force_control.yaml: pulled by force, the sphere comes off at the fold of the
+    curve, Maugis-Dugdale's load-controlled pull-off (measured 1e-11), by a jump."""
+    res = solvers.simulate(load_scene(CONFIGS / "sphere_force_control.yaml"))
+    assert res.F_pulloff == pytest.approx(res.analytic["maugis_F_pulloff_load"], rel=1e-4)
     assert res.F_jump_out == pytest.approx(res.F_pulloff, rel=1e-12)
 
 
