@@ -236,3 +236,31 @@ def test_machine_settings_are_checked(overrides, key):
     with pytest.raises(SceneError) as info:
         load_scene(CONFIGS / "seed_flat_punch.yaml", overrides=overrides)
     assert key in str(info.value)
+
+
+@pytest.mark.parametrize("material", [{"kind": "elastic", "G": 1e6},
+                                      {"kind": "kelvin_voigt", "G": 1e6, "eta": 1e3}])
+def test_finite_punch_behind_a_spring_reaches_its_strength_limit(material):
+    """chi_R = 0.94: the face's strength limits the bond. Behind a 1 kN/m spring the face
+    fails when the spring pulls pi R^2 sigma_c: an elastic punch then exactly F/(k v) later
+    than under a rigid pull (measured 1e-14); a Kelvin-Voigt one snaps (once reported no
+    detachment at all: the spring's lost balance hid the face's failure)."""
+    R, sigma_c, k_m, v = 1e-5, 1e6, 1e3, 1e-3
+
+    def run(machine):
+        loading = {"kind": "constant_velocity", "v": v}
+        if machine:
+            loading["machine_stiffness"] = machine
+        return solvers.simulate(parse_scene({
+            "schema": 1, "name": "spring",
+            "geometry": {"kind": "flat_punch", "radius": R, "cohesive_zone": "internal"},
+            "material": material, "adhesion": {"kind": "dugdale", "sigma_c": sigma_c,
+                                               "delta": 3e-6},
+            "loading": loading, "model": {"until": "detach"}, "numerics": {"rtol": 1e-3}}))
+
+    limit = math.pi * R**2 * sigma_c
+    res = run(k_m)
+    assert math.isfinite(res.t_detach) and not res.notes
+    assert res.F_total_detach == pytest.approx(limit, rel=1e-5)
+    if material["kind"] == "elastic":
+        assert res.t_detach == pytest.approx(run(None).t_detach + limit / (k_m * v), rel=1e-9)

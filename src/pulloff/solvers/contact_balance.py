@@ -32,6 +32,12 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
         out = _newton(lambda z: _with_force(build(step, z[0]), force_residual),
                       np.array([H_guess]), H_scale, scale)
         if out is None:
+            # The phase's own end (a bond past the face's strength) comes first where it is
+            # met on the way: the branch ends by it, not by the spring.
+            try:
+                build(step, H_guess)
+            except phases.Lost as lost:
+                raise lost from None
             raise phases.Lost("balance")
         return out[0]
     if now.phase == st.CONTACT_PHASE and stepper.setup.flat:

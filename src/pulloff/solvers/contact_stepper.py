@@ -598,11 +598,17 @@ class Stepper:
                 self._touch()
                 return self._jump("in")
             if what == "balance" and now.alpha > 0.0:
-                # No equilibrium under the spring or the force: the indenter snaps off.
+                # No equilibrium under the spring or the force: the indenter snaps off; a bond
+                # that had held until then fails in that instant (its onset).
+                if now.phase in (st.BONDED, st.PINNED) and not any(
+                        name == "onset" for _, name in self.events):
+                    self.events.append((now.t, "onset"))
                 self.events.append((now.t, "jump_out"))
             now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
             self.events.append((now.t, "separated"))
             self._row(now)
+            if self.setup.until == "detach" and any(n == "onset" for _, n in self.events):
+                return self._physical_end("onset")
             return self._physical_end("separation")
         if what == "birth":
             now.phase = st.ZONE
