@@ -237,7 +237,13 @@ def smooth_contact(step, H, guess_alpha, guess_beta):
         # No history (elastic), or none that can act in zero time (a jump of a solid with
         # an instantaneous modulus): the edge condition fixes the zone end.
         return elastic_contact(step, H, guess_alpha)
-    held = zone_end(step, H, now.alpha, guess_beta)
+    try:
+        held = zone_end(step, H, now.alpha, guess_beta)
+    except Lost:
+        # No zone end for the edge where it was: the edge must move. Pressing in, it advances.
+        if H < now.H:
+            return advancing(step, H, guess_alpha, guess_beta)
+        return receding(step, H, guess_alpha)
     ell = math.sqrt(max((held.beta - now.alpha) * (held.beta + now.alpha), 0.0))
     if held.edge_load > ell:
         return receding(step, H, guess_alpha)

@@ -123,8 +123,9 @@ def refine(stepper) -> int:
     """Replay new elements into the zone where fewer than :data:`MIN_INSIDE` lie inside it
     (evenly in the angle the gap is integrated in); returns how many were placed."""
     now = stepper.now
-    if now.beta <= 0.0 or now.phase in (st.APART, st.DONE) or not stepper.setup.flat:
-        return 0
+    if (now.beta <= 0.0 or now.phase in (st.APART, st.DONE)
+            or (not stepper.setup.flat and _stateless(stepper.setup.law))):
+        return 0  # an elastic smooth contact places fresh elements in every evaluation
     nodes = stepper.nodes
     lo, hi = nodes.below(now.alpha), nodes.below(now.beta)
     inside = nodes.xi[lo:hi]
