@@ -245,10 +245,12 @@ def smooth_contact(step, H, guess_alpha, guess_beta):
             return advancing(step, H, guess_alpha, guess_beta)
         return receding(step, H, guess_alpha)
     ell = math.sqrt(max((held.beta - now.alpha) * (held.beta + now.alpha), 0.0))
-    if held.edge_load > ell:
-        return receding(step, H, guess_alpha)
-    if held.edge_free_u > H + ind.g(now.alpha):
+    pulls = held.edge_load > ell
+    passes = held.edge_free_u > H + ind.g(now.alpha)
+    if passes and (H < now.H or not pulls):  # pressing in, the free side decides first
         return advancing(step, H, guess_alpha, guess_beta)
+    if pulls:
+        return receding(step, H, guess_alpha)
     return held
 
 
