@@ -36,21 +36,37 @@ def plot_history(record: dict, path, title: str | None = None) -> Path:
     ``(b - a)/a`` with the contact edge, and gap histories; a driver/spring panel for a
     compliant machine; a loading path's force-displacement loop instead (:func:`plot_path`).
     Saves a PNG at ``path``."""
-    import numpy as np
-
-    if _get(_scene(record), "loading", "kind") == "path":
-        return plot_path(record, path, title)
-    h = record["history"]
-    s = record["summary"]
-    an = record["analytic"]
     scene = _scene(record)
+    if _get(scene, "loading", "kind") == "path":
+        return plot_path(record, path, title)
     stiffness = _get(scene, "loading", "machine_stiffness")
-    t_ms = np.asarray(h["t"]) * 1e3
     n_panels = 4 if _finite(stiffness) else 3
     fig, axes = plt.subplots(n_panels, 1, figsize=(9.0, 2.6 * n_panels + 0.6), sharex=True,
                              constrained_layout=True)
-    ax_f, ax_r, ax_g = axes[:3]
+    _force_panel(axes[0], record)
+    _zone_panel(axes[1], record, scene)
+    _gap_panel(axes[2], record, scene)
+    if n_panels == 4:
+        _machine_panel(axes[3], record, scene, stiffness)
+    axes[-1].set_xlabel("time [ms]")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return _save(fig, path)
 
+
+def _time_ms(record):
+    import numpy as np
+
+    return np.asarray(record["history"]["t"]) * 1e3
+
+
+def _force_panel(ax_f, record) -> None:
+    """Both forces, the closed forms as levels (or named in the legend when off scale), the
+    onset and the peak."""
+    import numpy as np
+
+    h, s, an = record["history"], record["summary"], record["analytic"]
+    t_ms = _time_ms(record)
     ax_f.plot(t_ms, h["F_contact"], label="F_contact (simulation)", color="C0")
     ax_f.plot(t_ms, h["F_total"], label="F_total (simulation)", color="C1", ls="--")
     scale = np.nanmax(np.abs(np.concatenate([np.asarray(h["F_contact"], float),
@@ -77,8 +93,14 @@ def plot_history(record: dict, path, title: str | None = None) -> Path:
     _legend(ax_f)
     ax_f.grid(alpha=0.3)
 
-    # The zone width relative to the contact radius is the quantity that matters; a and b
-    # themselves differ in the sixth digit for a thin zone.
+
+def _zone_panel(ax_r, record, scene) -> None:
+    """The zone width relative to the contact radius, the quantity that matters (a and b
+    themselves differ in the sixth digit for a thin zone), with the contact edge."""
+    import numpy as np
+
+    h = record["history"]
+    t_ms = _time_ms(record)
     b = np.asarray(h["b"], dtype=float)
     a = np.asarray(h["a"], dtype=float) if "a" in h else None
     ref = a if a is not None else np.full_like(b, _get(scene, "geometry", "radius") or np.nan)
@@ -103,7 +125,12 @@ def plot_history(record: dict, path, title: str | None = None) -> Path:
     ax_r.legend(handles, labels, fontsize=7.5, loc="upper left", bbox_to_anchor=(1.1, 1.0),
                 borderaxespad=0.0, frameon=False)
 
-    ax_g.plot(t_ms, np.asarray(h["gap"]) * 1e9, color="C2", label="gap at r = b")
+
+def _gap_panel(ax_g, record, scene) -> None:
+    import numpy as np
+
+    ax_g.plot(_time_ms(record), np.asarray(record["history"]["gap"]) * 1e9, color="C2",
+              label="gap at r = b")
     delta = _get(scene, "adhesion", "delta")
     if _finite(delta):
         ax_g.axhline(delta * 1e9, color="0.4", ls=":", lw=1.0, label="delta (onset)")
@@ -111,27 +138,28 @@ def plot_history(record: dict, path, title: str | None = None) -> Path:
     _legend(ax_g)
     ax_g.grid(alpha=0.3)
 
-    if n_panels == 4:
-        ax_m = axes[3]
-        lift = np.asarray(h["h"], dtype=float)
-        v = _get(scene, "loading", "v")
-        if _get(scene, "loading", "kind") == "constant_velocity" and _finite(v):
-            driver = (_get(scene, "loading", "h0") or 0.0) + v * np.asarray(h["t"])
-            driver_label = "driver h0 + v t"
-        else:
-            driver = lift + np.asarray(h["F_total"], dtype=float) / stiffness
-            driver_label = "driver (h + F_total / k)"
-        ax_m.plot(t_ms, driver * 1e6, color="0.3", label=driver_label)
-        ax_m.plot(t_ms, lift * 1e6, color="C0", ls="--", label="punch lift h")
-        ax_m.fill_between(t_ms, lift * 1e6, driver * 1e6, color="C0", alpha=0.12,
-                          label=f"spring stretch (k = {stiffness:.3g} N/m)")
-        ax_m.set_ylabel("machine [um]")
-        _legend(ax_m)
-        ax_m.grid(alpha=0.3)
-    axes[-1].set_xlabel("time [ms]")
-    if title:
-        fig.suptitle(title, fontsize=10)
-    return _save(fig, path)
+
+def _machine_panel(ax_m, record, scene, stiffness) -> None:
+    """The driver, the punch and the spring's stretch between them."""
+    import numpy as np
+
+    h = record["history"]
+    t_ms = _time_ms(record)
+    lift = np.asarray(h["h"], dtype=float)
+    v = _get(scene, "loading", "v")
+    if _get(scene, "loading", "kind") == "constant_velocity" and _finite(v):
+        driver = (_get(scene, "loading", "h0") or 0.0) + v * np.asarray(h["t"])
+        driver_label = "driver h0 + v t"
+    else:
+        driver = lift + np.asarray(h["F_total"], dtype=float) / stiffness
+        driver_label = "driver (h + F_total / k)"
+    ax_m.plot(t_ms, driver * 1e6, color="0.3", label=driver_label)
+    ax_m.plot(t_ms, lift * 1e6, color="C0", ls="--", label="punch lift h")
+    ax_m.fill_between(t_ms, lift * 1e6, driver * 1e6, color="C0", alpha=0.12,
+                      label=f"spring stretch (k = {stiffness:.3g} N/m)")
+    ax_m.set_ylabel("machine [um]")
+    _legend(ax_m)
+    ax_m.grid(alpha=0.3)
 
 
 #: Closed forms of a path drawn as levels on the loop: key, label, colour, style.
