@@ -193,40 +193,13 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     """
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     s0 = problem.s_of(0.0)
-    # Elements already inside the zone at t = 0: as many as entering elements would fill the
-    # same range of sigma.
-    s_ref = problem.s_of(n_stop * dt)
-    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
-    if max_elements is not None:
-        # A budget bounds this part too (a quarter of it): its mesh then stops refining with
-        # the step.
-        n_pre = min(n_pre, max(8, int(max_elements) // 4))
-    sig_pre, offset_pre = preloaded_mesh(s0, n_pre)
-    if c == 0.0:
-        # An elastic element follows its load at once, also the step lift h0 at t = 0.
-        U_pre = np.sqrt(offset_pre * (s0 + sig_pre)) / k
-    else:
-        U_pre = np.zeros_like(sig_pre)  # a damper cannot move instantly (MODEL.md: u(x,0) = 0)
+    sig_pre, offset_pre, U_pre, dx_pre, pre_w = _preloaded(problem, dt, n_stop, n_preloaded,
+                                                           max_elements)
     capacity = n_stop + 2
     if max_elements is not None:
         capacity = min(capacity, max(16, int(max_elements) - sig_pre.size))
-    born = np.zeros(capacity, dtype=np.int64)
-    sig_born = np.zeros(capacity)
-    U_born = np.zeros(capacity)
-    dx_born = np.zeros(capacity)
-    # Quadrature weights of thinned intervals (only ever written by thinning).
-    thin_w = np.zeros((capacity if max_elements is not None else 1, 4))
+    born, sig_born, U_born, dx_born, thin_w = _entered_arrays(capacity, max_elements)
     sig_born[0] = s0
-    nodes_pre = np.append(sig_pre, s0)
-    x_pre = np.sqrt(1.0 + nodes_pre * nodes_pre)
-    # kernels.interval_width, vectorised: x widths without cancellation for thin zones.
-    dx_pre = np.zeros(nodes_pre.size)
-    dx_pre[1:] = (np.diff(nodes_pre) * (nodes_pre[1:] + nodes_pre[:-1])
-                  / (x_pre[1:] + x_pre[:-1]))
-    # With a budget the preloaded mesh stops refining with the step: the cubic on v keeps
-    # its error far below the trapezoid's (fourth order in its spacing).
-    pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
-             and sig_pre.size >= 3 else np.zeros((1, 4)))
     n_born = 1
     weights = step_weights(k, c, dt, n_stop + 2)
     history = _History(problem, record_every, stream, stream_every)
@@ -236,20 +209,10 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
         return FoundationRun(dt, np.zeros(1), np.array([gap0]), 0.0, sig_pre.size + n_born, 0,
                              steps=np.zeros(1, dtype=np.int64))
 
-    # Stops for snapshots and progress; the kernel runs uninterrupted between them. A snapshot
-    # between two steps interpolates the states at both ends (second order, like the stepper).
-    wanted = {}
-    for ts in snapshot_times:
-        n0 = min(n_stop, max(0, int(math.floor(ts / dt))))
-        wanted[ts] = (n0, min(n_stop, n0 + 1))
-    capture_steps = {n for pair in wanted.values() for n in pair}
+    wanted, capture_steps, stops = _stops(snapshot_times, dt, n_stop)
     captured = {}
     if 0 in capture_steps:
         captured[0] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
-    # ~50 stops for progress and Ctrl-C (a signal is seen when the kernel returns; the rows
-    # of that call are lost); at least _MIN_CHUNK steps each, so small runs pay no overhead.
-    chunk = max(_MIN_CHUNK, n_stop // 50)
-    stops = sorted((set(range(chunk, n_stop, chunk)) | capture_steps | {n_stop}) - {0})
     buffer = min(n_stop, _CHUNK_STEPS)
     t_buf = np.zeros(buffer + 1)
     gap_buf = np.zeros(buffer + 1)
@@ -294,16 +257,74 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
         tail = history.tail
         t_detach = _crossing_time(tail[:, 0], tail[:, 1], tail.shape[0] - 1)
     t_end = t_detach if crossed else step * dt
-    snapshots = []
-    for ts in sorted(wanted):
-        n0, n1 = wanted[ts]
-        # Only times the run reached: none after detachment or past t_max.
-        if ts <= t_end and n0 in captured and n1 in captured:
-            snapshots.append((ts, *_interpolate_field(problem, captured[n0], captured[n1],
-                                                      ts / dt - n0, ts)))
+    snapshots = _snapshots(problem, wanted, captured, dt, t_end)
     steps, t, gap = history.arrays(dt, step)
     return FoundationRun(dt, t, gap, t_detach, sig_pre.size + n_born, step, snapshots,
                          interrupted, steps=steps, n_thinned=n_thinned)
+
+
+def _entered_arrays(capacity: int, max_elements):
+    """Arrays of the elements entering the zone: step born, sigma, U, width, and the
+    quadrature weights of thinned intervals (only ever written by thinning)."""
+    return (np.zeros(capacity, dtype=np.int64), np.zeros(capacity), np.zeros(capacity),
+            np.zeros(capacity), np.zeros((capacity if max_elements is not None else 1, 4)))
+
+
+def _stops(snapshot_times, dt: float, n_stop: int):
+    """Where the kernel pauses: the steps around each snapshot time (a snapshot between two
+    steps interpolates the states at both ends, second order like the stepper) and ~50 stops
+    for progress and Ctrl-C (a signal is seen when the kernel returns; the rows of that call
+    are lost), at least _MIN_CHUNK steps apart so small runs pay no overhead. Returns
+    ``(wanted, capture_steps, stops)``."""
+    wanted = {}
+    for ts in snapshot_times:
+        n0 = min(n_stop, max(0, int(math.floor(ts / dt))))
+        wanted[ts] = (n0, min(n_stop, n0 + 1))
+    capture_steps = {n for pair in wanted.values() for n in pair}
+    chunk = max(_MIN_CHUNK, n_stop // 50)
+    stops = sorted((set(range(chunk, n_stop, chunk)) | capture_steps | {n_stop}) - {0})
+    return wanted, capture_steps, stops
+
+
+def _preloaded(problem: Problem, dt: float, n_stop: int, n_preloaded, max_elements):
+    """The elements already inside the zone at ``t = 0``: ``(sigma, offset, U, dx, cubic
+    weights)``, as many as entering elements would fill the same range of sigma (a budget
+    bounds them to a quarter of it: the mesh then stops refining with the step)."""
+    k, c = problem.k, problem.c
+    s0 = problem.s_of(0.0)
+    s_ref = problem.s_of(n_stop * dt)
+    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
+    if max_elements is not None:
+        n_pre = min(n_pre, max(8, int(max_elements) // 4))
+    sig_pre, offset_pre = preloaded_mesh(s0, n_pre)
+    if c == 0.0:
+        # An elastic element follows its load at once, also the step lift h0 at t = 0.
+        U_pre = np.sqrt(offset_pre * (s0 + sig_pre)) / k
+    else:
+        U_pre = np.zeros_like(sig_pre)  # a damper cannot move instantly (MODEL.md: u(x,0) = 0)
+    nodes_pre = np.append(sig_pre, s0)
+    x_pre = np.sqrt(1.0 + nodes_pre * nodes_pre)
+    # kernels.interval_width, vectorised: x widths without cancellation for thin zones.
+    dx_pre = np.zeros(nodes_pre.size)
+    dx_pre[1:] = (np.diff(nodes_pre) * (nodes_pre[1:] + nodes_pre[:-1])
+                  / (x_pre[1:] + x_pre[:-1]))
+    # With a budget the preloaded mesh stops refining with the step: the cubic on v keeps
+    # its error far below the trapezoid's (fourth order in its spacing).
+    pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
+             and sig_pre.size >= 3 else np.zeros((1, 4)))
+    return sig_pre, offset_pre, U_pre, dx_pre, pre_w
+
+
+def _snapshots(problem: Problem, wanted: dict, captured: dict, dt: float, t_end: float):
+    """The requested fields, each interpolated between the two steps around its time; only
+    times the run reached (none after detachment or past t_max)."""
+    out = []
+    for ts in sorted(wanted):
+        n0, n1 = wanted[ts]
+        if ts <= t_end and n0 in captured and n1 in captured:
+            out.append((ts, *_interpolate_field(problem, captured[n0], captured[n1],
+                                                ts / dt - n0, ts)))
+    return out
 
 
 def _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step) -> int:
