@@ -30,7 +30,8 @@ from pulloff.studies import sweeps as sw
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 SEED = CONFIGS / "seed_flat_punch.yaml"
 QUICK = ["--set", "numerics.rtol=1e-3"]
-POSIX = pytest.mark.skipif(os.name != "posix", reason="POSIX signals and special files")
+POSIX = pytest.mark.skipif(os.name != "posix", reason="SIGTERM, SIGHUP, FIFOs and device "
+                           "nodes exist only on POSIX systems")
 
 
 def _listing(folder: Path) -> list[str]:
@@ -49,7 +50,10 @@ def _one_error_line(err: str, command: str, *words) -> str:
 
 # --- output targets -------------------------------------------------------------------------
 
-def _make_target(kind: str, path: Path, tmp_path: Path) -> None:
+def _make_target(kind: str, path: Path, tmp_path: Path) -> Path:
+    """The output target of the given kind at ``path`` (a character device: a private copy of
+    /dev/full where device nodes can be made, else the system's /dev/null, which a user
+    without that right cannot harm either); returns it."""
     if kind == "directory":
         path.mkdir()
     elif kind == "symlink":
@@ -63,7 +67,8 @@ def _make_target(kind: str, path: Path, tmp_path: Path) -> None:
         try:  # a private copy of /dev/full (1, 7): never the system's own node
             os.mknod(path, stat.S_IFCHR | 0o666, os.makedev(1, 7))
         except (PermissionError, OSError):
-            pytest.skip("cannot create a device node here (not root, or no CAP_MKNOD)")
+            return Path("/dev/null")
+    return path
 
 
 KINDS = ["directory", "symlink", "dangling symlink", "fifo", "character device"]
@@ -72,13 +77,14 @@ KINDS = ["directory", "symlink", "dangling symlink", "fifo", "character device"]
 @POSIX
 @pytest.mark.parametrize("kind", KINDS)
 def test_run_refuses_an_output_that_is_not_a_regular_file(tmp_path, capsys, kind):
-    target = tmp_path / "out.h5"
-    _make_target(kind, target, tmp_path)
+    target = _make_target(kind, tmp_path / "out.h5", tmp_path)
     before = _listing(tmp_path)
+    beside = _listing(target.parent)
     mode = os.lstat(target).st_mode
     assert main(["run", str(SEED), "-o", str(target), "-q", *QUICK]) == 2
     _one_error_line(capsys.readouterr().err, "run", "-o", str(target), "not a regular file")
     assert _listing(tmp_path) == before  # no .png beside it, no lock, no temp file
+    assert _listing(target.parent) == beside
     assert os.lstat(target).st_mode == mode
     if kind == "symlink":
         assert (tmp_path / "real.h5").read_bytes() == b"keep me"
@@ -87,8 +93,7 @@ def test_run_refuses_an_output_that_is_not_a_regular_file(tmp_path, capsys, kind
 @POSIX
 @pytest.mark.parametrize("kind", ["fifo", "symlink"])
 def test_sweep_and_plot_refuse_such_outputs_too(tmp_path, capsys, kind):
-    target = tmp_path / "target.h5"
-    _make_target(kind, target, tmp_path)
+    target = _make_target(kind, tmp_path / "target.h5", tmp_path)
     before = _listing(tmp_path)
     assert main(["sweep", str(SEED), "--vary", "loading.v=1e-3,2e-3", "-o", str(target),
                  "-q", *QUICK]) == 2
@@ -284,22 +289,24 @@ def _alive(pid: int) -> bool:
     return "\nState:\tZ" not in status  # a zombie has exited
 
 
-def _long_sweep(out: Path) -> subprocess.Popen:
-    return _pulloff("sweep", SEED, "--vary", "loading.v=log:1e-4:1e-2:3000", "-o", out,
+def _long_sweep(out: Path):
+    """A 3000-scene sweep on two workers, once both workers run: ``(process, worker pids)``."""
+    proc = _pulloff("sweep", SEED, "--vary", "loading.v=log:1e-4:1e-2:3000", "-o", out,
                     "--workers", "2", "-q")
+    _wait_for(lambda: len(_children(proc.pid)) >= 2, what="two workers")
+    return proc, _children(proc.pid)
 
 
 linux_proc = pytest.mark.skipif(not Path("/proc/self/task").exists() or
                                 not sys.platform.startswith("linux"),
-                                reason="reads worker pids from /proc")
+                                reason="finds the sweep's worker processes through Linux's "
+                                       "/proc")
 
 
 @linux_proc
 def test_sighup_of_a_sweep_keeps_its_rows_and_ends_its_workers(tmp_path):
     out = tmp_path / "hup.h5"
-    proc = _long_sweep(out)
-    _wait_for(lambda: len(_children(proc.pid)) >= 2, what="two workers")
-    workers = _children(proc.pid)
+    proc, workers = _long_sweep(out)
     _wait_for(out.exists, what="the first rows in the file")
     proc.send_signal(signal.SIGHUP)
     _, err = proc.communicate(timeout=20)
@@ -316,9 +323,7 @@ def test_sighup_of_a_sweep_keeps_its_rows_and_ends_its_workers(tmp_path):
 @linux_proc
 def test_sweep_workers_die_with_their_parent(tmp_path):
     out = tmp_path / "orphans.h5"
-    proc = _long_sweep(out)
-    _wait_for(lambda: len(_children(proc.pid)) >= 2, what="two workers")
-    workers = _children(proc.pid)
+    proc, workers = _long_sweep(out)
     proc.kill()
     # A caller reading the pipe is not left hanging by orphans holding it open.
     proc.communicate(timeout=10)
