@@ -69,7 +69,7 @@ def kv_levels():
 
 def test_kelvin_voigt_crack_grows_at_finite_speed_past_a_higher_peak(kv_levels):
     rows, summary, setup = kv_levels[LEVELS[-1]]
-    t, a, F = rows[:, 0], rows[:, 2], rows[:, 6]
+    a, F = rows[:, 2], rows[:, 6]
     assert summary["t_separation"] > 1.2 * summary["t_detach"]  # finite crack speed
     assert summary["F_peak_total"] > summary["F_total_detach"] * (1 + 1e-3)  # measured +6.1 %
     # The edge never advances; a(t) and F(t) are continuous: a step moves the edges by at

@@ -18,7 +18,6 @@ import datetime as _dt
 import os
 import socket
 import stat
-import tempfile
 from pathlib import Path
 
 import h5py
@@ -26,6 +25,7 @@ import numpy as np
 
 from .. import __version__
 from ..model import outputs
+from . import files
 
 SCHEMA_VERSION = 1
 
@@ -108,15 +108,11 @@ def _existing_parent(path: Path) -> Path | None:
         parent = parent.parent
 
 
-def _temp_prefix(path: Path) -> str:
-    return f".{path.name}."
-
-
 def stale_temp_files(path) -> list[Path]:
     """Temporary files an interrupted or killed writer of ``path`` left beside it."""
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
-    prefix = _temp_prefix(path)
+    prefix = files.temp_prefix(path)
     try:
         names = os.listdir(folder)
     except OSError:
@@ -191,10 +187,7 @@ def atomic_file(path, key: str = "-o"):
     """
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, tmp_name = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=".tmp",
-                                            dir=path.parent)
-        os.close(handle)
+        tmp_name = files.new_temp(path)
     except OSError as exc:
         raise OutputError(f"{key} = {path}: cannot write ({exc.strerror or exc})") from None
     try:
@@ -202,11 +195,7 @@ def atomic_file(path, key: str = "-o"):
             with h5py.File(tmp_name, "w") as f:
                 stamp(f)
                 yield f
-            # mkstemp creates 0600; a result file gets the permissions of any new file here.
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp_name, 0o666 & ~umask)
-            os.replace(tmp_name, path)
+            files.publish(tmp_name, path)
         except OSError as exc:
             reason = (exc.strerror or str(exc)).replace(tmp_name, str(path))
             raise OutputError(f"{key} = {path}: cannot write ({reason})") from None

@@ -357,26 +357,15 @@ def plot_error_map(emap: dict, grid: dict, claim: float, path) -> Path:
 def _save(fig, path) -> Path:
     """Save a figure atomically: written beside ``path`` under a temporary name and renamed,
     so an existing figure is replaced whole or not at all."""
-    import os
-    import tempfile
+    from .files import replaced_whole
 
     path = Path(path)
     fmt = path.suffix[1:].lower() or "png"
     try:
         if fmt not in fig.canvas.get_supported_filetypes():
             raise ValueError(f"{path}: cannot draw a .{fmt} figure (use .png, .pdf or .svg)")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        os.close(handle)
-        try:
+        with replaced_whole(path) as tmp:
             fig.savefig(tmp, dpi=120, format=fmt)
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
     finally:
         plt.close(fig)
     return path

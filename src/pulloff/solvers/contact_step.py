@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kernels import contact as K
-from .contact_state import CONTACT, FREE
 
 _TINY = 1e-13
 

@@ -142,20 +142,10 @@ def validate(out_dir=None, rtol: float = 1e-5, small: bool = False, workers=None
 
 def _write_text(path: Path, text: str) -> None:
     """Replace ``path`` whole or not at all (a temporary file beside it, renamed)."""
-    import os
-    import tempfile
+    from ..io.files import replaced_whole
 
-    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as f:
-            f.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with replaced_whole(path) as tmp:
+        Path(tmp).write_text(text, encoding="utf-8")
 
 
 #: Files a validation writes in its folder.
