@@ -389,6 +389,17 @@ def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_b
     once, not every step. ``S - sigma`` comes from exact offsets: ``offset_pre + k t`` for
     preloaded elements, ``k dt age`` for entered ones (``kt``, ``k_dt``); ``born[0]`` is 0.
     """
+    return (_preloaded_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, sig_born, U_born,
+                                n_born, S, kt)
+            + _entered_integral(born, sig_born, U_born, dx_born, thin_w, n_born, step, S, k_dt,
+                                ratio, w_young, w_old))
+
+
+@njit(cache=True)
+def _preloaded_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, sig_born, U_born, n_born,
+                        S, kt):
+    """The part of :func:`displacement_integral` over the elements loaded since ``t = 0`` and
+    the oldest entered one."""
     total = 0.0
     n_pre = sig_pre.shape[0]
     cubic = pre_w.shape[0] == n_pre + 1
@@ -419,6 +430,14 @@ def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_b
     if cubic and n_pre >= 1:
         w = pre_w[n_pre]
         total += w[0] * p1 + w[1] * p2 + w[2] * v_prev
+    return total
+
+
+@njit(cache=True)
+def _entered_integral(born, sig_born, U_born, dx_born, thin_w, n_born, step, S, k_dt, ratio,
+                      w_young, w_old):
+    """The part of :func:`displacement_integral` over the entered elements."""
+    total = 0.0
     # Entered elements, youngest (age 0) last; g = v / R(age) is smooth. A thinned interval
     # ending at j - 1 is added at j, once v at its right neighbour is known.
     n_tab = w_young.shape[0]

@@ -214,13 +214,9 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     if 0 in capture_steps:
         captured[0] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
     buffer = min(n_stop, _CHUNK_STEPS)
-    t_buf = np.zeros(buffer + 1)
-    gap_buf = np.zeros(buffer + 1)
-    step = 0
-    crossed = False
-    interrupted = False
-    n_thinned = 0
-    j_consecutive = 0
+    t_buf, gap_buf = np.zeros(buffer + 1), np.zeros(buffer + 1)
+    step = n_thinned = j_consecutive = 0
+    crossed = interrupted = False
     try:
         for stop in stops:
             while step < stop:
@@ -239,10 +235,8 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
                     crossed = True
                     break
                 if code == kernels.MARCH_FULL:
-                    n_born = _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step)
-                    # The young elements thinning keeps are the consecutive tail.
-                    gaps = np.nonzero(np.diff(born[:n_born]) > 1)[0]
-                    j_consecutive = int(gaps[-1]) + 1 if gaps.size else 0
+                    n_born, j_consecutive = _thin(born, sig_born, U_born, dx_born, thin_w,
+                                                  n_born, step)
                     n_thinned += 1
             if step in capture_steps:
                 captured[step] = _field(sig_pre, U_pre, sig_born, U_born, n_born)
@@ -252,10 +246,8 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
         # Compiled code does not see signals; Python raises on return, before ``step`` is
         # updated, so the arrays and the history hold a consistent state up to ``step``.
         interrupted = True
-    t_detach = math.nan
-    if crossed:
-        tail = history.tail
-        t_detach = _crossing_time(tail[:, 0], tail[:, 1], tail.shape[0] - 1)
+    tail = history.tail
+    t_detach = _crossing_time(tail[:, 0], tail[:, 1], tail.shape[0] - 1) if crossed else math.nan
     t_end = t_detach if crossed else step * dt
     snapshots = _snapshots(problem, wanted, captured, dt, t_end)
     steps, t, gap = history.arrays(dt, step)
@@ -327,8 +319,9 @@ def _snapshots(problem: Problem, wanted: dict, captured: dict, dt: float, t_end:
     return out
 
 
-def _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step) -> int:
-    """Thin full element arrays to at most half their size (see ``kernels.thin_entered``)."""
+def _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step) -> tuple[int, int]:
+    """Thin full element arrays to at most half their size (see ``kernels.thin_entered``);
+    returns how many are kept and where their consecutive young tail starts."""
     capacity = sig_born.size
     keep_young = capacity // 4
     # A geometric grading from keep_young to the oldest age in capacity/4 elements.
@@ -338,7 +331,9 @@ def _thin(born, sig_born, U_born, dx_born, thin_w, n_born, step) -> int:
                                   keep_young, ratio_max)
     if n_kept > capacity // 2 + capacity // 4:
         raise RuntimeError(f"thinning kept {n_kept} of {capacity} elements")  # a bug, not input
-    return n_kept
+    # The young elements thinning keeps are the consecutive tail.
+    gaps = np.nonzero(np.diff(born[:n_kept]) > 1)[0]
+    return n_kept, (int(gaps[-1]) + 1 if gaps.size else 0)
 
 
 def _interpolate_field(problem, field0, field1, weight, t):
