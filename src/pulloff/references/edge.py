@@ -331,6 +331,17 @@ def _slow_step(k, plo, X2, T1, ymode, smode, tco, yco, sco, sp, lam, sigma, tol,
     Splits [plo, 1] at the zeros of g = b(p)^2 - x^2 (entry/exit of the zone) and removes the
     square root of the load by p = p* +- r^2 at every zero of g at or near an end of a
     loaded piece (also at a zero just outside the step: onset integrated in every step)."""
+    roots = _zone_crossings(k, plo, X2, ymode, smode, tco, yco, sco, sp)
+    tr0, tr1, tps, tsg, nt = _piece_tasks(k, plo, X2, roots, ymode, smode, tco, yco, sco, sp)
+    for j in range(nt):
+        _adapt_step(k, X2, tr0[j], tr1[j], tps[j], tsg[j], T1, ymode, smode, tco, yco, sco,
+                    sp, lam, sigma, tol, out, xk, wk, wg)
+
+
+@nb.njit(cache=False)
+def _zone_crossings(k, plo, X2, ymode, smode, tco, yco, sco, sp):
+    """The zeros of g = b(p)^2 - x^2 in [plo, 1] and the nearest one just outside on either
+    side (an onset integrated in every step), ascending."""
     ns = 8
     # pass 1: sample g, collect the brackets of its zeros inside [plo, 1] and just outside
     ps = np.empty(ns + 1)
@@ -364,7 +375,15 @@ def _slow_step(k, plo, X2, T1, ymode, smode, tco, yco, sco, sp, lam, sigma, tol,
     roots = np.empty(nr)
     for j in range(nr):
         roots[j] = _groot(k, X2, blo[j], bhi[j], bg[j], ymode, smode, tco, yco, sco, sp)
-    # pass 2: pieces between plo, the interior zeros and 1, each as (r0, r1, p*, sign) tasks
+    return roots
+
+
+@nb.njit(cache=False)
+def _piece_tasks(k, plo, X2, roots, ymode, smode, tco, yco, sco, sp):
+    """The pieces of [plo, 1] between the interior zeros, each as a task ``(r0, r1, p*,
+    sign)`` of :func:`_adapt_step` (``sign`` 0: no square root to remove); returns the task
+    arrays and their count."""
+    nr = roots.size
     brk = np.empty(nr + 2)
     nb_ = 0
     brk[nb_] = plo
@@ -415,9 +434,7 @@ def _slow_step(k, plo, X2, T1, ymode, smode, tco, yco, sco, sp, lam, sigma, tol,
         else:
             tr0[nt], tr1[nt], tps[nt], tsg[nt] = u0, u1, 0.0, 0
             nt += 1
-    for j in range(nt):
-        _adapt_step(k, X2, tr0[j], tr1[j], tps[j], tsg[j], T1, ymode, smode, tco, yco, sco,
-                    sp, lam, sigma, tol, out, xk, wk, wg)
+    return tr0, tr1, tps, tsg, nt
 
 
 @nb.njit(cache=False)
@@ -1074,16 +1091,7 @@ class EdgeRun:
                 self.segs[0].fix[L] = "t"
             if (not self.external and self.SQ[L] >= self.R
                     and "strength_limit" not in self.events):
-                # internal zone: the bond is gone when q_b = 2 sigma_c R (a = 0, F = pi R^2
-                # sigma_c); the zone stays pinned at b = R until gap(R) = delta
-                if exact:
-                    ts = brentq(lambda tt: self._s_exact(tt) - self.R, self.T[L - 1], t,
-                                xtol=1e-300, rtol=8.9e-16)
-                else:
-                    ps = brentq(lambda pp: _poly(self.sco[L - 1], pp) - self.R, 0.0, 1.0,
-                                xtol=1e-300, rtol=8.9e-16)
-                    ts = float(_poly(self.tco[L - 1], ps))
-                self.events["strength_limit"] = ts
+                self.events["strength_limit"] = self._strength_limit_time(L, t, exact)
             if self.verbose and L % 100 == 0:
                 print(f"  bonded L={L} t={t:.6g} gap-delta={f:.3e}", flush=True)
             if f >= 0.0:
@@ -1091,6 +1099,26 @@ class EdgeRun:
             g_prev, t_prev = f + self.delta, t
             if self.t_max is not None and t > self.t_max:
                 raise RuntimeError("no onset before t_max")
+        L = self._land_on_onset(L, t, ym, exact)
+        self.L = L
+        self.events["onset"] = L
+        self._ft_onset = (g_prev, t_prev)
+        self.segs[0].i1 = L
+
+    def _strength_limit_time(self, L, t, exact):
+        """Internal zone: when the bonded line load reaches 2 sigma_c R inside step ``L``
+        (a = 0, F = pi R^2 sigma_c); the zone then stays pinned at b = R until gap(R) =
+        delta."""
+        if exact:
+            return brentq(lambda tt: self._s_exact(tt) - self.R, self.T[L - 1], t,
+                          xtol=1e-300, rtol=8.9e-16)
+        ps = brentq(lambda pp: _poly(self.sco[L - 1], pp) - self.R, 0.0, 1.0,
+                    xtol=1e-300, rtol=8.9e-16)
+        return float(_poly(self.tco[L - 1], ps))
+
+    def _land_on_onset(self, L, t, ym, exact):
+        """Make point ``L`` the onset (gap = delta), which lies inside the step ending at
+        ``t``; returns its index (a point too close before it is dropped)."""
         t0 = self.T[L - 1]
         k = L - 1
         tco_full = self.tco[k].copy()
@@ -1130,10 +1158,7 @@ class EdgeRun:
                 lo = self.T[L - 1] + 0.5 * (lo - self.T[L - 1])
             ton = brentq(G, lo, hi, xtol=1e-300, rtol=8.9e-16, maxiter=200)
             G(ton)
-        self.L = L
-        self.events["onset"] = L
-        self._ft_onset = (g_prev, t_prev)
-        self.segs[0].i1 = L
+        return L
 
     # ---------------------------------------------------------------- propagation
     def _forces_at(self, i):
@@ -1620,38 +1645,59 @@ def flat_punch_reference(*, G_inf, eta=0.0, arms=(), sigma_c, delta, R, v, h0=0.
     params = dict(G_inf=G_inf, eta=eta, arms=tuple(tuple(float(v_) for v_ in x) for x in arms),
                   sigma_c=sigma_c, delta=delta, R=R, v=v, h0=h0, zone=zone,
                   machine_stiffness=machine_stiffness)
-    external = zone == "external"
-    t1 = _elastic_guess(G_inf, sigma_c, delta, R, v, h0, external)
+    if scales is None:
+        scales = _pilot_scales(params, t_max)
+    scales = tuple(float(x) for x in scales)
+    lv = [level] if level is not None else range(min_level, max_level + 1)
+    tstart = _time.time()
+    results, levels, (est, rich, order, per) = _ladder(
+        params, scales, lv, N0, rtol, t_max, level is None, time_budget, tstart, verbose)
+    out = dict(results[-1])
+    out["error_estimate"] = est if len(results) >= 2 else float("nan")
+    out["error_estimate_richardson"] = rich
+    out["observed_order"] = order
+    out["error_estimates"] = per
+    out["levels"] = levels
+    out["scales"] = dict(t1_scale=scales[0], t2_scale=scales[1], y_scale=scales[2], N0=N0)
+    out["wall_time_total"] = _time.time() - tstart
+    return out
+
+
+def _pilot_scales(params, t_max):
+    """Step scales ``(t1, t2, y)`` from a coarse pilot run: the onset time, the duration of
+    the propagation and ``R^2``."""
+    R = params["R"]
+    t1 = _elastic_guess(params["G_inf"], params["sigma_c"], params["delta"], R, params["v"],
+                        params["h0"], params["zone"] == "external")
     if not t1 > 0:
-        t1 = delta / v
-    # pilot at a coarse resolution: the time scales of the bonded and propagating phases
+        t1 = params["delta"] / params["v"]
     pilot = None
-    for n_pilot in (() if scales is not None else (8, 16)):
+    for n_pilot in (8, 16):
         try:
             pilot = _one_level(params, n_pilot, (t1, t1, R * R), t_max, False)
         except (RuntimeError, _NoRoot, FloatingPointError, np.linalg.LinAlgError):
             continue
         if pilot["separation_kind"] != "lost_branch":
             break
-    if scales is None:
-        if pilot is None:
-            raise RuntimeError("pilot run failed")
-        t_on = pilot["t_onset"]
-        t1s = t_on if t_on > 0 else t1
-        t2s = pilot["t_separation"] - t_on
-        if not t2s > 1e-6 * t1s:
-            t2s = t1s
-        scales = (t1s, t2s, R * R)
-    scales = tuple(float(x) for x in scales)
-    levels = []
-    results = []
-    lv = [level] if level is not None else range(min_level, max_level + 1)
-    est = rich = order = float("nan")
-    per = {}
-    tstart = _time.time()
+    if pilot is None:
+        raise RuntimeError("pilot run failed")
+    t_on = pilot["t_onset"]
+    t1s = t_on if t_on > 0 else t1
+    t2s = pilot["t_separation"] - t_on
+    if not t2s > 1e-6 * t1s:
+        t2s = t1s
+    return (t1s, t2s, R * R)
+
+
+def _ladder(params, scales, lv, N0, rtol, t_max, converge, time_budget, tstart, verbose):
+    """Run the levels ``N = N0 2^l`` for ``l`` in ``lv`` until (``converge``) the estimate is
+    below ``rtol`` with at least three levels, or the time budget would be overrun; returns
+    the per-level results, their scalars and ``_estimate``'s tuple."""
+    levels, results = [], []
+    estimate = (float("nan"), float("nan"), float("nan"), {})
     for l in lv:
         N = N0 * 2 ** l
-        if time_budget is not None and len(results) >= 1 and level is None:
+        if time_budget is not None and len(results) >= 1 and converge:
             last = results[-1]["wall_time"]
             growth = max(2.0, last / max(results[-2]["wall_time"], 1e-3)) if len(results) >= 2 \
                 else 4.0
@@ -1668,18 +1714,10 @@ def flat_punch_reference(*, G_inf, eta=0.0, arms=(), sigma_c, delta, R, v, h0=0.
             print(f"level {l} N={N}: " + " ".join(f"{k}={res[k]:.12g}" for k in _SCALARS)
                   + f"  [{res['wall_time']:.1f} s]", flush=True)
         if len(results) >= 2:
-            est, rich, order, per = _estimate(results)
-            if level is None and len(results) >= 3 and est < rtol:
+            estimate = _estimate(results)
+            if converge and len(results) >= 3 and estimate[0] < rtol:
                 break
-    out = dict(results[-1])
-    out["error_estimate"] = est if len(results) >= 2 else float("nan")
-    out["error_estimate_richardson"] = rich
-    out["observed_order"] = order
-    out["error_estimates"] = per
-    out["levels"] = levels
-    out["scales"] = dict(t1_scale=scales[0], t2_scale=scales[1], y_scale=scales[2], N0=N0)
-    out["wall_time_total"] = _time.time() - tstart
-    return out
+    return results, levels, estimate
 
 
 def _estimate(results):
