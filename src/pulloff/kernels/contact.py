@@ -493,11 +493,10 @@ R_GAP, R_EDGE_LOAD, R_EDGE_FREE_U, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = ran
 @njit(cache=True)
 def path_root(p0, p1, p2, x):
     """The fraction of the step where the path passes ``x`` (clamped to the step)."""
-    roots = np.empty(2)
-    n = path_roots(p0, p1, p2, x, -1e-12, 1.0 + 1e-12, roots)
+    n, r1, r2 = path_roots2(p0, p1, p2, x, -1e-12, 1.0 + 1e-12)
     if n == 0:
         return 1.0 if abs(path_value(p0, p1, p2, 1.0) - x) < abs(p0 - x) else 0.0
-    return min(max(roots[0], 0.0), 1.0)
+    return min(max(r1, 0.0), 1.0)
 
 
 @njit(cache=True)
@@ -606,17 +605,17 @@ def _filtered_lift(Hf0, arm_mus, hp, s, out):
 
 @njit(cache=True)
 def _contact_modes(x, s_c, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj, n_all,
-                   kappa_arms, tau_arms, nm, prof, out):
-    """Modes of a contact element at ``x`` released at fraction ``s_c``."""
+                   kappa_arms, tau_arms, nm, prof, work, out):
+    """Modes of a contact element at ``x`` released at fraction ``s_c`` (``work``: two rows
+    of scratch, one entry per arm)."""
     G = _profile(sc, x, prof)
     if tau_arms.size == 0:
         if nm > 0:
             out[0] = path_value(hp[0], hp[1], hp[2], s_c) + G
         return
     na = tau_arms.size
-    Hf = np.empty(na)
+    Hf, mem = work[0], work[1]
     _filtered_lift(Hf0, arm_mus, hp, s_c, Hf)
-    mem = np.empty(na)
     _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, sc[S_T0] + s_c * sc[S_DT], x, mem)
     for k in range(nm):
         acc = 0.0
@@ -651,6 +650,7 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
     m = 0
     y0 = np.zeros(max(nm, 1))
     ints = np.empty(max(nm, 1))
+    work = np.empty((2, max(tau_arms.size, 1)))
     for j in range(k_a + (hi - lo) + k_b + 1 - first_b):
         s0 = 0.0
         for k in range(nm):
@@ -659,7 +659,7 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
             x = alpha0 + (alpha1 - alpha0) * (k_a - j) / k_a
             s0 = path_root(ap[0], ap[1], ap[2], x)
             _contact_modes(x, s0, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj, n_all,
-                           kappa_arms, tau_arms, nm, prof, y0)
+                           kappa_arms, tau_arms, nm, prof, work, y0)
             flag = 1
         elif j < k_a + hi - lo:
             i = lo + j - k_a
@@ -676,7 +676,7 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
             if status[i] == 1:  # released by the receding edge inside the step
                 s0 = path_root(ap[0], ap[1], ap[2], x)
                 _contact_modes(x, s0, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj,
-                               n_all, kappa_arms, tau_arms, nm, prof, y0)
+                               n_all, kappa_arms, tau_arms, nm, prof, work, y0)
             else:
                 lag = (sc[S_T0] - t_last[i]) / sc[S_DT]
                 for k in range(nm):

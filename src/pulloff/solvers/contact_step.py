@@ -189,12 +189,3 @@ class Step:
         ev.xi, ev.virtual, ev.stays = out[0][:m], out[3][:m] == 1, out[3][:m] == 2
         ev.dt = self.dt
         return ev
-
-
-def _crossing(p, x):
-    """The fraction where the path ``p`` passes ``x`` (nearest to the step, clamped to it)."""
-    roots = np.empty(2)
-    n = K.path_roots(p[0], p[1], p[2], x, -1e-12, 1.0 + 1e-12, roots)
-    if n == 0:
-        return 1.0 if abs(K.path_value(*p, 1.0) - x) < abs(p[0] - x) else 0.0
-    return min(max(roots[0], 0.0), 1.0)

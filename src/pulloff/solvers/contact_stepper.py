@@ -545,9 +545,7 @@ class Stepper:
         nodes.status[i] = st.CONTACT
         law = self.setup.law
         ap = step.path("alpha", ev.alpha)
-        from .contact_step import _crossing
-
-        s_c = _crossing(ap, nodes.xi[i])
+        s_c = K.path_root(ap[0], ap[1], ap[2], nodes.xi[i])
         nodes.tj[i] = self.now.t + s_c * step.dt
         if not law.maxwell:
             return
