@@ -136,12 +136,10 @@ class Stepper:
         bonded from the start)."""
         nodes = self.nodes
         law = self.setup.law
-        m = law.tau_arms.size
-        idx = np.nonzero(nodes.status[:nodes.n] == st.CONTACT)[0]
-        if idx.size == 0:
-            return np.zeros(m)
-        mem = nodes.D[idx, :m] * np.exp(-(t - nodes.tj[idx])[:, None] / law.tau_arms)
-        return np.array([np.interp(xi, nodes.xi[idx], mem[:, i]) for i in range(m)])
+        out = np.empty(law.tau_arms.size)
+        K._memory(nodes.xi, nodes.status, nodes.D, nodes.tj, nodes.n, law.kappa_arms,
+                  law.tau_arms, t, xi, out)
+        return out
 
     def free_modes_at(self, x):
         """Modes of a free element at ``x`` now: interpolated between the free elements around
