@@ -13,7 +13,7 @@ import numpy as np
 
 from ..kernels import contact as K
 from . import contact_state as st
-from .contact_step import filter_poly, quadratic_path
+from .contact_step import quadratic_path
 
 #: The fewest elements strictly inside the zone before new ones are replayed into it.
 MIN_INSIDE = 8
@@ -102,10 +102,8 @@ def _crossing(p, x):
 def _filtered(law, Hf0, hp, dt, s):
     if not law.maxwell:
         return Hf0
-    mus = dt / law.tau_arms * s
-    out = np.exp(-mus) * Hf0
-    for i, mu in enumerate(mus):
-        out[i] += filter_poly(mu, hp[0], hp[1] * s, hp[2] * s * s)
+    out = np.empty(Hf0.size)
+    K._filtered_lift(Hf0, dt / law.tau_arms, np.array(hp, float), s, out)
     return out
 
 

@@ -30,13 +30,6 @@ def quadratic_path(prev, now, new, r):
     return now, new - now - p2, p2
 
 
-def filter_poly(mu, h0, h1, h2):
-    """``int_0^1 mu e^{-mu (1-s)} (h0 + h1 s + h2 s^2) ds``: what a dashpot of relaxation
-    ``1/mu`` steps gains from a lift polynomial in the step."""
-    m0, m1, m2 = K.exp_moments(mu)
-    return mu * (h0 * m0 + h1 * m1 + h2 * m2)
-
-
 @dataclass
 class Evaluation:
     """The end of a trial step (dimensionless)."""
@@ -116,11 +109,9 @@ class Step:
 
     def filtered_lift(self, H_new, s=1.0):
         """The arms' filtered lift ``Hf`` (``tau dHf/dt = H - Hf``) at fraction ``s``."""
-        h0, h1, h2 = self.lift_path(H_new)
-        mus = self.arm_mus * s
-        out = np.exp(-mus) * self.now.Hf
-        for i, mu in enumerate(mus):
-            out[i] += filter_poly(mu, h0, h1 * s, h2 * s * s)
+        out = np.empty(self.now.Hf.size)
+        K._filtered_lift(self.now.Hf, self.arm_mus, np.array(self.lift_path(H_new), float), s,
+                         out)
         return out
 
     # --- the contact side ----------------------------------------------------------------
