@@ -46,6 +46,7 @@ RADAU3 = np.array([(4.0 - math.sqrt(6.0)) / 10.0, (4.0 + math.sqrt(6.0)) / 10.0,
 _x6, _w6 = np.polynomial.legendre.leggauss(6)
 GL6_X = 0.5 * (_x6 + 1.0)
 GL6_W = 0.5 * _w6
+GL2_X = 1.0 / math.sqrt(3.0)  # 2-point Gauss-Legendre node on [-1, 1]
 
 
 @njit(cache=True)
@@ -330,32 +331,82 @@ def _cubic_weights(t0, t1, t2, t3, a, b, w):
     w[3] = _basis_integral(t3, t0, t1, t2, a, b)
 
 
+#: A stencil node closer than this share of the interval to the stencil's last node on its side
+#: is passed over: Lagrange weights through clustered nodes (a zone end's graded start beside a
+#: wide released stretch) grow like the spacing ratio cubed and turn rounding into garbage.
+SPREAD = 0.25
+
+
+@njit(cache=True)
+def _spread_stencil(t, n, j, idx):
+    """Up to 4 nodes for the interval ``t[j]..t[j+1]``: its ends, then outward one side at a
+    time (left first), each at least ``SPREAD`` times the interval from the last one taken on
+    its side; on an even or gently graded mesh this is ``j-1..j+2`` (shifted at the ends).
+    Returns the count."""
+    gap = SPREAD * (t[j + 1] - t[j])
+    idx[0], idx[1] = j, j + 1
+    m, left, right, kl, kr = 2, j, j + 1, j - 1, j + 2
+    while m < 4:
+        grew = False
+        while kl >= 0 and t[left] - t[kl] < gap:
+            kl -= 1
+        if kl >= 0:
+            idx[m] = kl
+            left, kl, m, grew = kl, kl - 1, m + 1, True
+        if m == 4:
+            break
+        while kr < n and t[kr] - t[right] < gap:
+            kr += 1
+        if kr < n:
+            idx[m] = kr
+            right, kr, m, grew = kr, kr + 1, m + 1, True
+        if not grew:
+            break
+    return m
+
+
+@njit(cache=True)
+def _lagrange_integral_weights(ts, m, a, b, w):
+    """``w[k] = int_a^b l_k(t) dt`` for the Lagrange basis through ``ts[:m]`` (m <= 4), by
+    2-point Gauss-Legendre, exact for these cubics."""
+    half, mid = 0.5 * (b - a), 0.5 * (a + b)
+    for k in range(m):
+        w[k] = 0.0
+    for g in range(2):
+        x = mid + half * (GL2_X if g == 0 else -GL2_X)
+        for k in range(m):
+            lk = 1.0
+            for q in range(m):
+                if q != k:
+                    lk *= (x - ts[q]) / (ts[k] - ts[q])
+            w[k] += half * lk
+
+
 @njit(cache=True)
 def piecewise_cubic_integral(t, f, n):
     """``int_{t[0]}^{t[n-1]} f dt`` of the piecewise cubic through nodes ``t`` (ascending,
-    non-uniform): each interval uses the cubic through its 4 nearest nodes. Fewer than 4
-    nodes: the interpolating polynomial of them all."""
+    non-uniform): each interval uses the cubic through its well-spread neighbours
+    (:func:`_spread_stencil`; fewer than 4 where the mesh has no more: a lower degree)."""
     if n < 2:
         return 0.0
-    if n == 2:
-        return 0.5 * (t[1] - t[0]) * (f[0] + f[1])
-    if n == 3:
-        # The quadratic through the three, integrated exactly (Simpson on uneven nodes).
-        h0 = t[1] - t[0]
-        h1 = t[2] - t[1]
-        hs = h0 + h1
-        return hs / 6.0 * ((2.0 - h1 / h0) * f[0] + hs * hs / (h0 * h1) * f[1]
-                           + (2.0 - h0 / h1) * f[2])
     total = 0.0
     w = np.empty(4)
+    ts = np.empty(4)
+    idx = np.empty(4, dtype=np.int64)
     for j in range(n - 1):
-        s = min(max(j - 1, 0), n - 4)
+        if t[j + 1] <= t[j]:  # an empty interval (a zone of no width)
+            continue
+        m = _spread_stencil(t, n, j, idx)
         # Shift the origin to the interval for accuracy on tiny intervals far from 0.
         o = t[j]
-        _cubic_weights(t[s] - o, t[s + 1] - o, t[s + 2] - o, t[s + 3] - o, 0.0,
-                       t[j + 1] - o, w)
-        for m in range(4):
-            total += w[m] * f[s + m]
+        for k in range(m):
+            ts[k] = t[idx[k]] - o
+        if m == 4:
+            _cubic_weights(ts[0], ts[1], ts[2], ts[3], 0.0, t[j + 1] - o, w)
+        else:
+            _lagrange_integral_weights(ts, m, 0.0, t[j + 1] - o, w)
+        for k in range(m):
+            total += w[k] * f[idx[k]]
     return total
 
 
