@@ -32,7 +32,7 @@ _FIRST_N = 16
 #: What a level is judged by (summary names; nan where a run has none). The times of the peak
 #: forces are not among them: the time of a smooth maximum is ill-conditioned (an error
 #: ``e`` in the force moves it by ``sqrt(e)``), so they are reported uncontrolled.
-CONTROLLED = ("t_detach", "F_total_detach", "F_contact_detach", "t_separation",
+CONTROLLED = ("t_detach", "h_detach", "F_total_detach", "F_contact_detach", "t_separation",
               "F_peak_total", "F_peak_contact", "F_pulloff", "F_max_compressive", "F_jump_in",
               "h_jump_in", "F_jump_out", "h_jump_out", "energy_dissipated")
 

@@ -75,14 +75,14 @@ class FrozenSolver(Solver):
     def unsupported(self, scene) -> list[str]:
         out = []
         if scene.model.history != "frozen":
+            # The rest is listed too: routing names the problems of the closest solver.
             out.append(problem_line("model.history", scene.model.history,
                                     "the frozen solver is the closed form of history: frozen"))
-            return out
         why = ("the seed's frozen load history (eq. 31) is a closed form of a Kelvin-Voigt "
                "flat punch pulled to the onset; use history: exact")
         out += [line.split(": ", 1)[0] + ": " + why
                 for line in flat_punch_pull(scene, "frozen")]
-        if scene.material.kind not in ("kelvin_voigt", "elastic"):
+        if scene.model.history == "frozen" and scene.material.kind not in ("kelvin_voigt", "elastic"):
             out.append(problem_line("model.history", "frozen", f"{why} for a "
                                     f"{scene.material.kind}"))
         if scene.model.until != "detach":
