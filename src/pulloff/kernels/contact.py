@@ -688,7 +688,9 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
     nm = mus.size
     ap, bp, hp = paths[0], paths[1], paths[2]
     alpha0 = sc[S_ALPHA0]
-    k_a = int(sc[S_K_ALPHA]) if (sc[S_FLAT] > 0.0 and alpha1 < alpha0) else 0
+    # A receding edge releases new elements as well as the contact's own: a smooth indenter's
+    # contact elements are spaced as the approach captured them, often wider than the zone.
+    k_a = int(sc[S_K_ALPHA]) if alpha1 < alpha0 else 0
     start = max(sc[S_BETA0], sc[S_XIMAX], 0.0)
     fresh = sc[S_FRESH] > 0.0
     if fresh:
@@ -746,7 +748,21 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
         Uo[m] = u
         fo[m] = flag
         m += 1
+    if k_a > 0 and sc[S_FLAT] == 0.0:
+        _sort_gathered(xo, Yo, Uo, fo, m, nm)
     return m
+
+
+@njit(cache=True)
+def _sort_gathered(xo, Yo, Uo, fo, m, nm):
+    """The gathered elements in ascending ``x`` (stable: the existing ones keep their order),
+    once a receding smooth edge's new elements went in ahead of the contact's own."""
+    order = np.argsort(xo[:m], kind="mergesort")
+    x_s, U_s, f_s, Y_s = xo[:m][order], Uo[:m][order], fo[:m][order], Yo[:m][order]
+    for j in range(m):
+        xo[j], Uo[j], fo[j] = x_s[j], U_s[j], f_s[j]
+        for k in range(nm):
+            Yo[j, k] = Y_s[j, k]
 
 
 @njit(cache=True)
