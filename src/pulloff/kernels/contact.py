@@ -412,15 +412,26 @@ def piecewise_cubic_integral(t, f, n):
 
 @njit(cache=True)
 def extrapolate_cubic(t, f, n, x):
-    """The polynomial through the first ``min(n, 4)`` nodes, evaluated at ``x``."""
-    m = min(n, 4)
+    """The polynomial through up to 4 of the first nodes, evaluated at ``x`` (outside them):
+    the first, then each next one at least ``SPREAD`` times the distance to ``x`` beyond the
+    last taken (clustered nodes would multiply rounding by the distance ratio cubed)."""
+    idx = np.empty(4, dtype=np.int64)
+    idx[0] = 0
+    m = 1
+    gap = SPREAD * abs(x - t[0])
+    for j in range(1, n):
+        if m == 4:
+            break
+        if abs(t[j] - t[idx[m - 1]]) >= gap:
+            idx[m] = j
+            m += 1
     out = 0.0
-    for j in range(m):
+    for a in range(m):
         lj = 1.0
-        for k in range(m):
-            if k != j:
-                lj *= (x - t[k]) / (t[j] - t[k])
-        out += lj * f[j]
+        for b in range(m):
+            if b != a:
+                lj *= (x - t[idx[b]]) / (t[idx[a]] - t[idx[b]])
+        out += lj * f[idx[a]]
     return out
 
 

@@ -124,6 +124,14 @@ class Step:
             # free state it had (virgin: none), and meets the indenter with the glassy modulus.
             E = law.V @ self.s.free_modes_at(xi)
             return law.kappa_instant * (H_new + G) - float(np.dot(law.kappa_arms, E))
+        if law.maxwell and xi > self.now.alpha and not self.s.setup.flat:
+            # Beyond the contact the edge reaches a free element: its dashpots are where the
+            # free side left them, relaxing toward the indenter from the step's start.
+            E = law.V @ self.s.free_modes_at(xi)
+            D = E - self.now.Hf - self.s.setup.indenter.g(xi)
+            memory = float(np.dot(law.kappa_arms, D * np.exp(-self.dt / law.tau_arms)))
+            return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
+                    - memory)
         if law.maxwell:
             memory = self.s.contact_memory(xi, self.now.t + self.dt)
             return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
@@ -165,7 +173,12 @@ class Step:
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         if self.fresh:
             lo = hi = 0
-        size = (hi - lo) + self.k_alpha + int(sc[K.S_K_BETA]) + 1
+        k_alpha = self.k_alpha
+        if alpha < now.alpha and not self.fresh:
+            # However far this trial recedes, the released stretch gets the zone's spacing.
+            k_alpha = max(k_alpha, int(math.ceil((now.alpha - alpha) / s.spacing(now))))
+            sc[K.S_K_ALPHA] = k_alpha
+        size = (hi - lo) + k_alpha + int(sc[K.S_K_BETA]) + 1
         nm = self.mus.size
         out = (np.empty(size), np.empty((size, nm)), np.empty(size),
                np.empty(size, dtype=np.int64))

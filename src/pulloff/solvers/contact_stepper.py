@@ -523,6 +523,8 @@ class Stepper:
                     if law.maxwell:
                         nodes.D[i, :law.tau_arms.size] = (law.V @ Yv[:law.n_modes] - ev.Hf
                                                           - self.setup.indenter.g(xv))
+        if self.setup.law.maxwell and not self.setup.flat:
+            self._edge_node(ev, t1)
         self.before = self.now
         self.last_dt = step.dt
         self.now = self.now.copy(t=t1, H=ev.H, Hdot=ev.Hdot, alpha=ev.alpha, beta=ev.beta,
@@ -532,6 +534,24 @@ class Stepper:
         self._row(self.now)
         replay.refine(self)
         replay.thin(self)
+
+    def _edge_node(self, ev, t1) -> None:
+        """An advancing smooth contact gets a contact element at its new edge, joined now
+        with the free state there: the contact memory then runs continuously into the free
+        side's state (the edge condition's load has no jump at the old edge)."""
+        nodes = self.nodes
+        if ev.alpha <= self.now.alpha or nodes.near(ev.alpha, 1e-12 * max(ev.alpha, 1.0)):
+            return
+        free = ~ev.stays & (ev.xi > ev.alpha)
+        if np.count_nonzero(free) < 2:
+            return
+        law = self.setup.law
+        xs = ev.xi[free]
+        Y = np.array([np.interp(ev.alpha, xs, ev.Y[free][:, k]) for k in range(law.n_modes)])
+        D = law.V @ Y - ev.Hf - self.setup.indenter.g(ev.alpha)
+        D_full = np.zeros(nodes.D.shape[1])
+        D_full[:law.tau_arms.size] = D
+        nodes.insert(float(ev.alpha), Y, st.CONTACT, D=D_full, tj=t1, t_last=t1)
 
     def _driver_rate(self) -> float:
         drive = self.drive
