@@ -157,6 +157,8 @@ def _path_lines(record) -> list[str]:
         ("Maugis-Dugdale F, load control", "maugis_F_pulloff_load", "F_pulloff"),
         ("Maugis-Dugdale F, displ. control", "maugis_F_pulloff_displacement", "F_jump_out"),
         ("JKR F, load control", "jkr_F_pulloff_load", "F_pulloff"),
+        ("elastic, relaxed modulus", "relaxed_F_pulloff", "F_pulloff"),
+        ("elastic, instantaneous modulus", "instant_F_pulloff", "F_pulloff"),
     ]
     shown = [(label, an.get(key), s.get(ref), ref) for label, key, ref in compare
              if isinstance(an.get(key), float) and math.isfinite(an.get(key))]

@@ -168,6 +168,8 @@ _PATH_FORMS = (
     ("mdr_dugdale_F_pulloff_displacement", "MDR-Dugdale pull-off, displacement control",
      "C5", "-."),
     ("jkr_F_pulloff_load", "JKR pull-off, load control", "C7", (0, (6, 2))),
+    ("relaxed_F_pulloff", "elastic pull-off, relaxed modulus", "C8", ":"),
+    ("instant_F_pulloff", "elastic pull-off, instantaneous modulus", "C9", "-."),
 )
 
 

@@ -620,7 +620,8 @@ def _elastic_onset(G, sigma_c, delta, a, internal):
 
 
 PATH_KEYS = ("mdr_dugdale_F_pulloff_load", "mdr_dugdale_F_pulloff_displacement",
-             "jkr_F_pulloff_load", "maugis_F_pulloff_load", "maugis_F_pulloff_displacement")
+             "jkr_F_pulloff_load", "maugis_F_pulloff_load", "maugis_F_pulloff_displacement",
+             "relaxed_F_pulloff", "instant_F_pulloff")
 
 
 def path_predictions(scene) -> dict:
@@ -631,7 +632,7 @@ def path_predictions(scene) -> dict:
 
     out = dict.fromkeys(PATH_KEYS, math.nan)
     geometry, spectrum = scene.geometry, scene.material.spectrum()
-    if geometry.kind == "flat_punch" or spectrum.relaxation_times:
+    if geometry.kind == "flat_punch":
         return out
     G = spectrum.G_inf
     sigma_c, delta, gamma = scene.adhesion.sigma_c, scene.adhesion.delta, scene.adhesion.gamma
@@ -639,6 +640,13 @@ def path_predictions(scene) -> dict:
         profile = ec.mdr_profile_tabulated(np.asarray(geometry.r), np.asarray(geometry.f))
     else:
         profile = ec.mdr_profile_power_law(*geometry.power_law())
+    if spectrum.relaxation_times:
+        # A solid with memory: the elastic curves of its two limits bound the pull-off.
+        if math.isfinite(spectrum.instantaneous_modulus):
+            for key, modulus in (("relaxed", G), ("instant", spectrum.instantaneous_modulus)):
+                out[f"{key}_F_pulloff"] = ec.mdr_dugdale_pulloff(
+                    profile, modulus, sigma_c=sigma_c, delta=delta, control="load").F
+        return out
     for control in ("load", "displacement"):
         out[f"mdr_dugdale_F_pulloff_{control}"] = ec.mdr_dugdale_pulloff(
             profile, G, sigma_c=sigma_c, delta=delta, control=control).F

@@ -22,6 +22,8 @@ WHERE = {
     "jump": "paths where the contact is gained or lost by a jump",
     "sphere": "spheres",
     "elastic_path": "elastic solids under a smooth indenter on a loading path",
+    "memory_path": "solids with memory (standard linear solid, Prony series) under a smooth "
+                   "indenter on a loading path",
 }
 
 
@@ -130,6 +132,11 @@ OUTPUTS = (
        "sphere"),
     _a("maugis_F_pulloff_displacement", "N", "Maugis-Dugdale pull-off of a sphere, "
                                              "displacement control", "sphere"),
+    _a("relaxed_F_pulloff", "N", "the largest tensile force of the elastic MDR-Dugdale curve "
+                                 "with the relaxed modulus G_inf: a slow retraction's limit",
+       "memory_path"),
+    _a("instant_F_pulloff", "N", "the same with the instantaneous modulus G(0+): a fast "
+                                 "retraction's limit", "memory_path"),
 )
 
 BY_NAME = {q.name: q for q in OUTPUTS}
