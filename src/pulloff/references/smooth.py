@@ -359,51 +359,9 @@ def _default_xmax(G_inf, sigma_c, delta, R, F_target):
     return 1.3 * max(b_zone, a_load) + 4.0 * a_load
 
 
-def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_target, v_out,
-                          n_elements, dt=None, dt_in=None, dh=None, x_max=None,
-                          max_steps=10_000_000):
-    """Approach-retract cycle of a rigid sphere on an MDR-Dugdale visco-elastic half-space.
-
-    Parameters (SI units)
-    ---------------------
-    G_inf : float          relaxed shear modulus [Pa] (E* = 4 G, incompressible).
-    arms : tuple of (G_i [Pa], tau_i [s])   Maxwell arms; ``()`` is elastic with ``G_inf``.
-    sigma_c : float        Dugdale stress [Pa];  delta : float  Dugdale range [m].
-    R : float              sphere radius [m] (``f = r^2/(2R)``, MDR ``g = x^2/R``).
-    h0 : float             initial lift [m] (> delta: starts apart).
-    v_in, v_out : float    approach / retraction speeds [m/s] (> 0).
-    F_target : float       compressive force [N] at which the approach turns (``F = -F_target``).
-    n_elements : int       number of grid cells on ``[0, x_max]`` (uniform).
-    dt : float             retraction time step [s]; ``dt_in`` approach step [s] (default: the
-                           same indenter displacement per step, ``dt * v_out / v_in``).
-    dh : float             alternative: indenter displacement per step [m] (both segments).
-    x_max : float          grid length [m] (default from elastic estimates with ``G_inf``).
-
-    Returns a dict with arrays ``t`` [s], ``h`` [m], ``F`` [N, tensile > 0], ``a``, ``b`` [m],
-    ``mode`` and ``segment`` (0 approach, 1 retract), the list ``jumps`` and the summary
-    ``F_pulloff`` (largest tensile force of the retraction, parabola-refined) and
-    ``h_pulloff`` (lift there), ``F_jump_out``/``h_jump_out`` (last contact state before the
-    jump out of contact; NaN if contact is lost continuously), ``F_after_jump_out``,
-    ``a_jump_out``, ``h_contact_lost``/``F_contact_lost`` (last contact sample), ``h_jump_in``, ``h_separation``, ``h_turn``, ``wall_time`` [s].
-    """
-    t_wall = _time.perf_counter()
-    model = _Model(G_inf, arms, sigma_c, delta, R)
-    if x_max is None:
-        # elastic pre-run with the relaxed modulus (no grid dependence when elastic)
-        x0 = _default_xmax(G_inf, sigma_c, delta, R, F_target)
-        pre = sphere_path_reference(G_inf=G_inf, arms=(), sigma_c=sigma_c, delta=delta, R=R, h0=h0,
-                                    v_in=v_in, F_target=F_target, v_out=v_out, n_elements=64,
-                                    dh=delta / 5.0, x_max=x0)
-        x_max = 1.5 * pre["b_max"]
-    X = np.linspace(0.0, x_max, int(n_elements) + 1)
-    sol = _Solver(model, X)
-    if dh is not None:
-        dt_out = dh / v_out
-        dt_inn = dh / v_in
-    else:
-        dt_out = float(dt)
-        dt_inn = float(dt_in) if dt_in is not None else dt * v_out / v_in
-
+def _march(sol, h0, segments, delta, F_target, max_steps):
+    """Step the approach and the retraction (``segments``: (speed [m/s], nominal step [s])),
+    resolving folds as jumps; the history (lists) and the jumps."""
     rec = dict(t=[0.0], h=[h0], F=[0.0], a=[0.0], b=[0.0], mode=["none"], segment=[0])
     jumps = []
 
@@ -419,7 +377,7 @@ def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_targ
     t = 0.0
     h = h0
     nsteps = 0
-    for seg, (v, dtn) in enumerate(((-v_in, dt_inn), (v_out, dt_out))):
+    for seg, (v, dtn) in enumerate(segments):
         dtry = dtn
         dt_min = 1e-10 * dtn
         # edge-speed limit per step, refined with the nominal step
@@ -468,9 +426,12 @@ def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_targ
             if seg == 1 and tr["mode"] == "none":
                 done = True
             dtry = min(max(grow, 0.5) * tr["dt"], dtn) if tr["dt"] > 0 else dtn
-    out = {k: np.array(vv) for k, vv in rec.items()}
-    out["jumps"] = jumps
-    # summary
+    return rec, jumps
+
+
+def _summary(out, jumps) -> dict:
+    """Pull-off (parabola-refined), jump out, contact loss, jump in and extent (SI)."""
+    res = {}
     seg = out["segment"]
     F = out["F"]
     hh = out["h"]
@@ -489,26 +450,79 @@ def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_targ
                 if x0 <= xv <= x2:
                     hp = xv
                     Fp = y0 + d01 * (xv - x0) + c2 * (xv - x0) * (xv - x1)
-    out["F_pulloff"] = float(Fp)
-    out["h_pulloff"] = float(hp)
+    res["F_pulloff"] = float(Fp)
+    res["h_pulloff"] = float(hp)
     jo = [j for j in jumps if j["segment"] == 1 and j["before"]["mode"] == "contact"
           and j["after"]["mode"] != "contact"]
     if jo:
-        out["F_jump_out"] = float(jo[0]["before"]["F"])
-        out["h_jump_out"] = float(jo[0]["before"]["h"])
-        out["a_jump_out"] = float(jo[0]["before"]["a"])
-        out["F_after_jump_out"] = float(jo[0]["after"]["F"])
+        res["F_jump_out"] = float(jo[0]["before"]["F"])
+        res["h_jump_out"] = float(jo[0]["before"]["h"])
+        res["a_jump_out"] = float(jo[0]["before"]["a"])
+        res["F_after_jump_out"] = float(jo[0]["after"]["F"])
     else:
-        out["F_jump_out"] = out["h_jump_out"] = out["a_jump_out"] = out["F_after_jump_out"] = float("nan")
+        res["F_jump_out"] = res["h_jump_out"] = res["a_jump_out"] = res["F_after_jump_out"] = float("nan")
     kc = [k for k in idx if out["mode"][k] == "contact"]
-    out["h_contact_lost"] = float(hh[kc[-1]]) if kc else float("nan")  # last contact sample
-    out["F_contact_lost"] = float(F[kc[-1]]) if kc else float("nan")
+    res["h_contact_lost"] = float(hh[kc[-1]]) if kc else float("nan")  # last contact sample
+    res["F_contact_lost"] = float(F[kc[-1]]) if kc else float("nan")
     ji = [j for j in jumps if j["segment"] == 0]
-    out["h_jump_in"] = float(ji[0]["before"]["h"]) if ji else float("nan")
-    out["h_turn"] = float(hh[idx[0] - 1])
-    out["h_separation"] = float(hh[-1])
-    out["b_max"] = float(np.max(out["b"]))
+    res["h_jump_in"] = float(ji[0]["before"]["h"]) if ji else float("nan")
+    res["h_turn"] = float(hh[idx[0] - 1])
+    res["h_separation"] = float(hh[-1])
+    res["b_max"] = float(np.max(out["b"]))
+    return res
+
+
+def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_target, v_out,
+                          n_elements, dt=None, dt_in=None, dh=None, x_max=None,
+                          max_steps=10_000_000):
+    """Approach-retract cycle of a rigid sphere on an MDR-Dugdale visco-elastic half-space.
+
+    Parameters (SI units)
+    ---------------------
+    G_inf : float          relaxed shear modulus [Pa] (E* = 4 G, incompressible).
+    arms : tuple of (G_i [Pa], tau_i [s])   Maxwell arms; ``()`` is elastic with ``G_inf``.
+    sigma_c : float        Dugdale stress [Pa];  delta : float  Dugdale range [m].
+    R : float              sphere radius [m] (``f = r^2/(2R)``, MDR ``g = x^2/R``).
+    h0 : float             initial lift [m] (> delta: starts apart).
+    v_in, v_out : float    approach / retraction speeds [m/s] (> 0).
+    F_target : float       compressive force [N] at which the approach turns (``F = -F_target``).
+    n_elements : int       number of grid cells on ``[0, x_max]`` (uniform).
+    dt : float             retraction time step [s]; ``dt_in`` approach step [s] (default: the
+                           same indenter displacement per step, ``dt * v_out / v_in``).
+    dh : float             alternative: indenter displacement per step [m] (both segments).
+    x_max : float          grid length [m] (default from elastic estimates with ``G_inf``).
+
+    Returns a dict with arrays ``t`` [s], ``h`` [m], ``F`` [N, tensile > 0], ``a``, ``b`` [m],
+    ``mode`` and ``segment`` (0 approach, 1 retract), the list ``jumps`` and the summary
+    ``F_pulloff`` (largest tensile force of the retraction, parabola-refined) and
+    ``h_pulloff`` (lift there), ``F_jump_out``/``h_jump_out`` (last contact state before the
+    jump out of contact; NaN if contact is lost continuously), ``F_after_jump_out``,
+    ``a_jump_out``, ``h_contact_lost``/``F_contact_lost`` (last contact sample), ``h_jump_in``, ``h_separation``, ``h_turn``, ``wall_time`` [s].
+    """
+    t_wall = _time.perf_counter()
+    model = _Model(G_inf, arms, sigma_c, delta, R)
+    if x_max is None:
+        # elastic pre-run with the relaxed modulus (no grid dependence when elastic)
+        x0 = _default_xmax(G_inf, sigma_c, delta, R, F_target)
+        pre = sphere_path_reference(G_inf=G_inf, arms=(), sigma_c=sigma_c, delta=delta, R=R, h0=h0,
+                                    v_in=v_in, F_target=F_target, v_out=v_out, n_elements=64,
+                                    dh=delta / 5.0, x_max=x0)
+        x_max = 1.5 * pre["b_max"]
+    X = np.linspace(0.0, x_max, int(n_elements) + 1)
+    sol = _Solver(model, X)
+    if dh is not None:
+        dt_out = dh / v_out
+        dt_inn = dh / v_in
+    else:
+        dt_out = float(dt)
+        dt_inn = float(dt_in) if dt_in is not None else dt * v_out / v_in
+
+    rec, jumps = _march(sol, h0, ((-v_in, dt_inn), (v_out, dt_out)), delta, F_target,
+                        max_steps)
+    out = {k: np.array(vv) for k, vv in rec.items()}
+    out["jumps"] = jumps
+    out.update(_summary(out, jumps))
     out["x_max"] = float(x_max)
-    out["n_steps"] = int(len(F))
+    out["n_steps"] = int(len(out["F"]))
     out["wall_time"] = _time.perf_counter() - t_wall
     return out
