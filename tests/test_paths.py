@@ -160,6 +160,20 @@ def test_sls_sphere_tends_to_the_elastic_limits(tau, modulus):
     assert s["h_jump_out"] == pytest.approx(leave.h, rel=2e-3)
 
 
+def test_a_solid_with_memory_gets_its_two_elastic_limits_beside_the_run():
+    from pulloff.model import analytic
+
+    scene = path_scene(13.0, material={"kind": "prony", "G_inf": G,
+                                       "terms": [{"G": 4e6, "tau": 1e-3}, {"G": 5e6, "tau": 1}]})
+    forms = analytic.path_predictions(scene)
+    profile = ec.mdr_profile_power_law(*scene.geometry.power_law())
+    for key, modulus in (("relaxed_F_pulloff", G), ("instant_F_pulloff", 10 * G)):
+        expected = ec.mdr_dugdale_pulloff(profile, modulus, sigma_c=scene.adhesion.sigma_c,
+                                          delta=scene.adhesion.delta, control="load").F
+        assert forms[key] == pytest.approx(expected, rel=1e-12)
+    assert math.isnan(forms["maugis_F_pulloff_load"])  # the elastic closed forms are not
+
+
 def test_near_elastic_sls_sphere_is_the_elastic_sphere():
     """An arm of 0.1 % of the modulus (the old stick rule held this contact 10x too long):
     within 0.1 % of the elastic pull-off and jump out (measured 6.7e-4, 6e-4)."""

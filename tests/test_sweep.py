@@ -172,3 +172,18 @@ def test_a_sweep_file_without_its_layout_is_a_clear_error(tmp_path):
         f.attrs["kind"] = "sweep"
     with pytest.raises(SweepError, match=r"old\.h5: a sweep file without axes, points"):
         load_sweep(path)
+
+
+def test_sweep_over_a_path_segment_speed_shows_and_plots_the_pull_off(tmp_path, capsys):
+    """A path's segment is swept by its index; the table and the figure then show F_pulloff
+    (the master curve of a retraction speed) instead of the seed's pull columns."""
+    out = tmp_path / "path.h5"
+    assert main(["sweep", str(CONFIGS / "sphere_elastic.yaml"), "--vary",
+                 "loading.segments.1.speed=1e-6,1e-5", "-o", str(out), "--set",
+                 "numerics.rtol=1e-3", "--workers", "1", "-q"]) == 0
+    printed = capsys.readouterr().out
+    assert "F_pulloff [N]" in printed and "lambda" in printed and "2 rows, 0 failed" in printed
+    t = sw.load_sweep(out).table
+    assert np.all(np.isfinite(t["F_pulloff"])) and np.all(t["F_pulloff"] > 2e-6)
+    assert main(["plot", str(out), "-o", str(tmp_path / "curve.png")]) == 0
+    assert (tmp_path / "curve.png").stat().st_size > 20_000

@@ -177,7 +177,8 @@ def _short(value) -> str:
 
 
 def format_sweep(result, max_rows: int = 40, title: str | None = None) -> str:
-    """One line per scene: the varied values, alpha/chi, the simulated force and the seed's;
+    """One line per scene: the varied values, the groups (alpha/chi of a pull, lambda and the
+    speed in relaxation times of a path), the simulated force and its closed forms;
     an interrupted sweep is marked INCOMPLETE with how many of its planned rows it holds."""
     table = result.table
     keys = [axis["key"] for axis in result.axes]
@@ -189,7 +190,16 @@ def format_sweep(result, max_rows: int = 40, title: str | None = None) -> str:
     if not getattr(result, "complete", True):
         lines.append(f"  INCOMPLETE: {n} of {planned if planned is not None else '?'} planned "
                      f"rows (interrupted; run the same sweep command to resume)")
-    columns = keys + ["alpha", "chi", "F_contact [N]", "closed form", "estimate", "status"]
+    ok = table["status"] == "ok"
+    path = bool(np.any(np.isfinite(np.asarray(table["F_pulloff"], dtype=float)[ok])))
+    # A pull: the seed's groups and closed form; a loading path: the elastic limits.
+    groups, (force, *forms) = ((("maugis_lambda", "speed_relaxation"),
+                                ("F_pulloff", "relaxed_F_pulloff", "instant_F_pulloff"))
+                               if path else (("alpha", "chi"),
+                                             ("F_contact_detach", "seed_closed_form_F")))
+    heads = (["lambda", "v tau / delta", "F_pulloff [N]", "relaxed", "instant"] if path else
+             ["alpha", "chi", "F_contact [N]", "closed form"])
+    columns = keys + heads + ["estimate", "status"]
     widths = [max(12, len(c)) for c in columns]
     lines.append("  " + " ".join(f"{c:>{w}}" for c, w in zip(columns, widths)))
     shown = range(n) if n <= max_rows else list(range(max_rows // 2)) + list(
@@ -199,11 +209,10 @@ def format_sweep(result, max_rows: int = 40, title: str | None = None) -> str:
         if r != previous + 1:
             lines.append(f"  ... {n - max_rows} rows not shown ...")
         previous = r
-        F = table["F_contact_detach"][r]
-        cells = [_short(table[k][r]) for k in keys] + [
-            _short(table["alpha"][r]), _short(table["chi"][r]), _short(F),
-            _rel(float(table["seed_closed_form_F"][r]), float(F)),
-            _short(table["error_estimate"][r]), str(table["status"][r])]
+        F = table[force][r]
+        cells = ([_short(table[k][r]) for k in keys] + [_short(table[g][r]) for g in groups]
+                 + [_short(F)] + [_rel(float(table[c][r]), float(F)) for c in forms]
+                 + [_short(table["error_estimate"][r]), str(table["status"][r])])
         line = "  " + " ".join(f"{c:>{w}}" for c, w in zip(cells, widths))
         if table["status"][r] != "ok":
             line += f"  ({table['message'][r]})"

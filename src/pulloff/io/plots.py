@@ -373,9 +373,21 @@ def _save(fig, path) -> Path:
     return path
 
 
+#: What a sweep plots: (simulated, closed forms as (column, label, style)), by kind of scene.
+_SWEEP_Y = {
+    "pull": ("F_contact_detach", "F_contact at detachment [N]",
+             (("seed_closed_form_F", "seed closed form (eqs. 64/89)", "--"),)),
+    "path": ("F_pulloff", "pull-off force F_pulloff [N]",
+             (("relaxed_F_pulloff", "elastic, relaxed modulus", ":"),
+              ("instant_F_pulloff", "elastic, instantaneous modulus", "-."))),
+}
+
+
 def plot_sweep(result, path, title: str | None = None) -> Path:
-    """Pull-off force against the first numeric axis of a sweep, one line per value of the
-    other axes (at most eight), simulation solid and the seed's closed form dashed."""
+    """The pull-off force against the first numeric axis of a sweep, one line per value of the
+    other axes (at most eight), simulation solid and the closed forms beside it: the seed's for
+    a pull, the elastic limits (relaxed and instantaneous modulus) for a loading path -- over
+    a retraction speed, the master curve."""
     import numpy as np
 
     t = result.table
@@ -385,6 +397,9 @@ def plot_sweep(result, path, title: str | None = None) -> Path:
         raise ValueError("a sweep needs a numeric axis to be plotted")
     x_key = numeric[0]
     others = [k for k in keys if k != x_key]
+    ok_all = t["status"] == "ok"
+    kind = "path" if np.any(np.isfinite(t["F_pulloff"][ok_all])) else "pull"
+    y_key, y_label, forms = _SWEEP_Y[kind]
     groups = {}
     for r in range(t["index"].size):
         groups.setdefault(tuple(t[k][r] for k in others), []).append(r)
@@ -394,21 +409,23 @@ def plot_sweep(result, path, title: str | None = None) -> Path:
         name = ", ".join(f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}"
                          for k, v in zip(others, label)) or "simulation"
         ok = t["status"][rows] == "ok"
-        ax.plot(t[x_key][rows][ok], t["F_contact_detach"][rows][ok], "o-", ms=3.5, color=f"C{i}",
+        ax.plot(t[x_key][rows][ok], t[y_key][rows][ok], "o-", ms=3.5, color=f"C{i}",
                 label=name)
-        ax.plot(t[x_key][rows][ok], t["seed_closed_form_F"][rows][ok], "--", lw=1.0,
-                color=f"C{i}")
-    x = t[x_key][t["status"] == "ok"]
+        for column, _, style in forms:
+            ax.plot(t[x_key][rows][ok], t[column][rows][ok], ls=style, lw=1.0, color=f"C{i}")
+    x = t[x_key][ok_all]
     if x.size and np.all(x > 0) and x.max() / x.min() > 20:
         ax.set_xscale("log")
-    positive = t["F_contact_detach"][t["status"] == "ok"]
+    positive = t[y_key][ok_all]
     if positive.size and np.all(positive > 0) and positive.max() / positive.min() > 20:
         ax.set_yscale("log")
-    ax.plot([], [], "k--", lw=1.0, label="seed closed form (eqs. 64/89)")
+    for column, label, style in forms:
+        if np.any(np.isfinite(t[column][ok_all])):
+            ax.plot([], [], "k", ls=style, lw=1.0, label=label)
     from ..model.scene import unit_of
 
     ax.set_xlabel(f"{x_key} [{unit_of(x_key) or '-'}]")
-    ax.set_ylabel("F_contact at detachment [N]")
+    ax.set_ylabel(y_label)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     if title:

@@ -79,9 +79,9 @@ class Segment(Kind):
     """One segment of a loading path: a move at constant speed [m/s] (displacement control) or
     constant force rate [N/s] (force control) until a target or an event, or a hold [s]."""
 
-    speed: Optional[Num] = Field(None, description="indenter speed, m/s (negative approaches)")
-    force_rate: Optional[Num] = Field(None, description="force rate under force control, N/s "
-                                                        "(tension positive)")
+    speed: Optional[Num] = Field(None, description="indenter speed (negative approaches), m/s")
+    force_rate: Optional[Num] = Field(None, description="force rate under force control "
+                                                        "(tension positive), N/s")
     hold: Optional[Num] = Field(None, gt=0, description="hold the lift (or, under force "
                                                         "control, the force) this long, s")
     until: Annotated[Optional[Target], BeforeValidator(_event_shorthand)] = Field(

@@ -241,6 +241,8 @@ def unit_of(key: str) -> str:
     cls, union = Scene, None
     info = None
     for part in key.split("."):
+        if part.isdigit():  # an item of a list (a path's segment): its class, already taken
+            continue
         if union is not None:
             cls = next((c for c in union if part in c.model_fields), None)
             union = None
