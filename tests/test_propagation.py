@@ -256,7 +256,9 @@ def test_finite_punch_behind_a_spring_reaches_its_strength_limit(material):
             "geometry": {"kind": "flat_punch", "radius": R, "cohesive_zone": "internal"},
             "material": material, "adhesion": {"kind": "dugdale", "sigma_c": sigma_c,
                                                "delta": 3e-6},
-            "loading": loading, "model": {"until": "detach"}, "numerics": {"rtol": 1e-3}}))
+            "loading": loading, "model": {"until": "detach"},
+            # (the strength limit is exact at any rtol; the Kelvin-Voigt snap is costly)
+            "numerics": {"rtol": 1e-3 if material["kind"] == "elastic" else 1e-2}}))
 
     limit = math.pi * R**2 * sigma_c
     res = run(k_m)
