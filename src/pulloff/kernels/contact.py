@@ -530,23 +530,9 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta):
     return piecewise_cubic_integral(th, f, m)
 
 
-@njit(cache=True)
-def interpolate_cubic(xs, fs, x):
-    """Lagrange polynomial through the (up to 4) points ``xs``, ``fs`` at ``x``."""
-    out = 0.0
-    m = xs.size
-    for j in range(m):
-        lj = 1.0
-        for k in range(m):
-            if k != j:
-                lj *= (x - xs[k]) / (xs[j] - xs[k])
-        out += lj * fs[j]
-    return out
-
-
 # --- one trial step, compiled ------------------------------------------------------------------
 #: Indices of the scalar results of :func:`evaluate_step`.
-R_GAP, R_EDGE_LOAD, R_EDGE_FREE_U, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(7)
+R_GAP, R_EDGE_LOAD, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(6)
 #: Indices of the step constants ``sc`` of :func:`evaluate_step`.
 (S_T0, S_DT, S_ALPHA0, S_BETA0, S_H1, S_HDOT, S_XIMAX, S_KAPPA, S_C, S_D, S_FLAT, S_AF, S_C_G,
  S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH) = range(17)
@@ -778,7 +764,7 @@ def _sort_gathered(xo, Yo, Uo, fo, m, nm):
 
 @njit(cache=True)
 def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
-    """The free part of the gap integral and a free element's displacement at the edge."""
+    """The free part of the gap integral (and the centre element's displacement into ``res``)."""
     H1 = sc[S_H1]
     centre = math.nan
     n_in = 0
@@ -803,34 +789,6 @@ def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
     U_beta = 0.0 if virgin else math.nan
     U_alpha = H1 + _profile(sc, alpha1, prof) if alpha1 > 0.0 else centre
     integral = free_gap_integral(xs, us, 0, n_in, alpha1, beta1, U_alpha, U_beta)
-    # A free element at the edge: the cubic in angle through the four nearest free ones.
-    target = angle(alpha1, beta1) if alpha1 > 0.0 else 0.5 * math.pi
-    ths = np.empty(4)
-    fs = np.empty(4)
-    count = 0
-    used = np.zeros(m, dtype=np.bool_)
-    for _ in range(4):
-        best, best_d = -1, math.inf
-        for j in range(m):
-            if used[j] or fo[j] == 2 or xo[j] >= beta1:
-                continue
-            d = abs(angle(xo[j], beta1) - target)
-            if d < best_d:
-                best, best_d = j, d
-        if best < 0:
-            break
-        used[best] = True
-        th = angle(xo[best], beta1)
-        duplicate = False
-        for k in range(count):
-            if ths[k] == th:
-                duplicate = True
-        if not duplicate:
-            ths[count] = th
-            fs[count] = Uo[best]
-            count += 1
-    res[R_EDGE_FREE_U] = (interpolate_cubic(ths[:count].copy(), fs[:count].copy(), target)
-                          if count >= 2 else math.nan)
     return integral
 
 
@@ -838,7 +796,7 @@ def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
 def evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out, res):
     """One trial step's end for trial edges ``alpha1``, ``beta1`` (and the lift in ``sc``):
     every element advanced (:func:`_gather`), then into ``res`` the gap at ``b``, the line
-    load of the contact element at ``a``, a free element's displacement there, the forces
+    load of the contact element at ``a``, the forces
     and the centre's displacement. Returns the element count written to ``out``."""
     xi, Y, status, D, tj, t_last = mesh
     ctil, kappa_arms, tau_arms, V_inv = law

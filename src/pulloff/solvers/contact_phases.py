@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from . import contact_state as st
 
 
@@ -210,9 +208,13 @@ def zone_only(step, H, guess_beta):
     return ev
 
 
-def elastic_contact(step, H, guess_alpha):
-    """An elastic solid in contact: it has no history, so the edge condition holds whichever
-    way the edge moves, and the zone end it gives leaves one unknown, the edge."""
+def smooth_contact(step, H, guess_alpha):
+    """A smooth indenter in contact, on a solid with an instantaneous modulus (elastic, or
+    Maxwell arms; a Kelvin-Voigt solid is refused upstream): the line load is continuous at
+    the edge whichever way it moves (MODEL.md 9), so the edge condition fixes the zone end and
+    ``gap(b) = delta`` the edge, on the branch of the last edge. (A rule that let the edge
+    stick while the contact pulled less than the zone held a near-elastic standard linear
+    solid's contact 10x too long.)"""
     now = step.now
 
     def residual(alpha):
@@ -224,108 +226,6 @@ def elastic_contact(step, H, guess_alpha):
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
     return step.evaluate(alpha, _edge_zone(step, H, alpha), H)
-
-
-def smooth_contact(step, H, guess_alpha, guess_beta):
-    """A smooth indenter in contact: ``gap(b) = delta`` always; the edge recedes where the
-    contact element would pull harder than the zone (a tensile singularity), advances where a
-    free element would pass through the indenter, and sticks otherwise."""
-    now = step.now
-    ind = step.s.setup.indenter
-    law = step.s.setup.law
-    if law.c == 0.0:
-        # A solid with an instantaneous modulus (elastic, or Maxwell arms): the line load is
-        # continuous at the edge whichever way it moves (MODEL.md 9), so the edge condition
-        # fixes the zone end and the gap the edge. (Letting the edge stick while the contact
-        # pulls less than the zone held a near-elastic SLS's contact 10x too long.)
-        return elastic_contact(step, H, guess_alpha)
-    try:
-        held = zone_end(step, H, now.alpha, guess_beta)
-    except Lost:
-        # No zone end for the edge where it was: the edge must move. Pressing in, it advances.
-        if H < now.H:
-            return advancing(step, H, guess_alpha, guess_beta)
-        return receding(step, H, guess_alpha)
-    ell = math.sqrt(max((held.beta - now.alpha) * (held.beta + now.alpha), 0.0))
-    pulls = held.edge_load > ell
-    passes = held.edge_free_u > H + ind.g(now.alpha)
-    if passes and (H < now.H or not pulls):  # pressing in, the free side decides first
-        return advancing(step, H, guess_alpha, guess_beta)
-    if pulls:
-        return receding(step, H, guess_alpha)
-    return held
-
-
-def _newton2(residual, x0, scale, max_iter=12):
-    """Damped Newton on two unknowns with a forward-difference Jacobian; None if it fails."""
-    x = np.array(x0, dtype=float)
-    try:
-        ev, r = residual(x)
-    except Lost:
-        return None
-    for _ in range(max_iter):
-        if np.all(np.abs(r) <= 1e-13):
-            return ev
-        J = np.empty((2, 2))
-        for j in range(2):
-            dx = x.copy()
-            dx[j] += 1e-7 * scale[j]
-            try:
-                J[:, j] = (residual(dx)[1] - r) / (1e-7 * scale[j])
-            except Lost:
-                return None
-        try:
-            step = np.linalg.solve(J, -r)
-        except np.linalg.LinAlgError:
-            return None
-        if not np.all(np.isfinite(step)):
-            return None
-        lam, norm = 1.0, np.linalg.norm(r)
-        while lam >= 1.0 / 64:
-            try:
-                ev_t, r_t = residual(x + lam * step)
-                if np.all(np.isfinite(r_t)) and np.linalg.norm(r_t) < (1 - 1e-4 * lam) * norm:
-                    break
-            except Lost:
-                pass
-            lam *= 0.5
-        else:
-            return ev if np.all(np.abs(r) <= 1e-10) else None
-        x, ev, r = x + lam * step, ev_t, r_t
-    return ev if np.all(np.abs(r) <= 1e-10) else None
-
-
-def advancing(step, H, guess_alpha, guess_beta):
-    """The edge advances to where a free element meets the indenter, the zone end where the
-    gap is delta: Newton on both from the predictor, else the zone end solved inside a search
-    for the edge."""
-    now = step.now
-    ind = step.s.setup.indenter
-    if not step.jump and guess_alpha > now.alpha:
-        def both(x):
-            a = max(x[0], now.alpha)
-            ev = step.evaluate(a, max(x[1], a), H)
-            return ev, np.array([ev.gap - 1.0, ev.edge_free_u - H - ind.g(a)])
-
-        width = max(guess_beta - guess_alpha, 1e-6 * max(guess_beta, 1.0))
-        ev = _newton2(both, (guess_alpha, max(guess_beta, guess_alpha + width)),
-                      (max(guess_alpha, 1.0), width))
-        if ev is not None and ev.alpha > now.alpha and ev.beta > ev.alpha:
-            return ev
-    cache = {}
-
-    def residual(alpha):
-        ev = zone_end(step, H, alpha, cache.get("beta", guess_beta))
-        cache["beta"] = ev.beta
-        return ev.edge_free_u - H - ind.g(alpha)
-
-    r_held = residual(now.alpha)
-    hi = max(guess_alpha, now.alpha) * 4.0 + 1.0
-    alpha = _root(residual, now.alpha, r_held, max(guess_alpha, now.alpha * (1 + 1e-9) + 1e-12),
-                  now.alpha, math.inf if step.jump else hi, step.jump)
-    if alpha is None:
-        raise Lost("advance")
-    return zone_end(step, H, alpha, cache.get("beta", guess_beta))
 
 
 def apart(step, H):

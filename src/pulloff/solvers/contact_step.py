@@ -40,7 +40,6 @@ class Evaluation:
     Hdot: float
     gap: float  # at the zone end (or at the centre when there is no zone)
     edge_load: float  # the contact element's line load at alpha
-    edge_free_u: float  # a free element's displacement at alpha (as if it stayed free)
     F_contact: float
     F_total: float
     centre_u: float  # displacement of the element at the centre, nan if none
@@ -188,7 +187,7 @@ class Step:
         m = K.evaluate_step(mesh, self.law, stepw, paths, sc, lo, hi, alpha, beta, nodes.n,
                             s.setup.indenter.table, out, res)
         ev = Evaluation(alpha, beta, H_new, Hdot, res[K.R_GAP], res[K.R_EDGE_LOAD],
-                        res[K.R_EDGE_FREE_U], res[K.R_F_CONTACT], res[K.R_F_TOTAL],
+                        res[K.R_F_CONTACT], res[K.R_F_TOTAL],
                         res[K.R_CENTRE_U], lo, hi, out[1][:m], out[2][:m], Hf)
         ev.xi, ev.virtual, ev.stays = out[0][:m], out[3][:m] == 1, out[3][:m] == 2
         ev.dt = self.dt

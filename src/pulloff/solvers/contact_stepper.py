@@ -316,7 +316,7 @@ class Stepper:
         if phase == st.CONTACT_PHASE:
             if self.setup.flat:
                 return phases.flat_contact(step, H, guess_a)
-            return phases.smooth_contact(step, H, guess_a, guess_b)
+            return phases.smooth_contact(step, H, guess_a)
         if phase == st.ZONE:
             return phases.zone_only(step, H, guess_b)
         return phases.apart(step, H)
