@@ -178,9 +178,9 @@ def flat_contact(step, H, guess_alpha):
     return receding(step, H, guess_alpha)
 
 
-def zone_end(step, H, alpha, guess_beta, top=math.inf):
+def zone_end(step, H, alpha, guess_beta, top=math.inf, wide=False):
     """``gap(b) = delta`` with the edge at ``alpha``, on the branch of the last zone end (and
-    below ``top``)."""
+    below ``top``); ``wide``: the nearest root however far."""
     now = step.now
 
     def residual(beta):
@@ -188,7 +188,7 @@ def zone_end(step, H, alpha, guess_beta, top=math.inf):
 
     start = min(max(now.beta, alpha * (1.0 + 1e-12), 1e-12), top)
     beta = _root(residual, start, residual(start), min(max(guess_beta, alpha), top), alpha, top,
-                 step.jump)
+                 step.jump or wide)
     if beta is None:
         raise Lost("zone")
     return step.evaluate(alpha, beta, H)
@@ -200,10 +200,12 @@ def zone_only(step, H, guess_beta):
     punch the zone only recedes: its broken bonds do not re-form during the pull (so an
     elastic punch, whose zone would have to grow, comes off at once; MODEL.md section 6)."""
     flat = step.s.setup.flat
-    ev = zone_end(step, H, 0.0, guess_beta, step.now.beta if flat else math.inf)
-    if ev.H - ev.centre_u < -1e-9 * max(abs(ev.H), 1.0) and (flat or step.jump):
+    born = not flat and step.now.beta <= 1e-9  # a zone just born grows like sqrt(t)
+    ev = zone_end(step, H, 0.0, guess_beta, step.now.beta if flat else math.inf, wide=born)
+    if ev.H - ev.centre_u < -1e-9 * max(abs(ev.H), 1.0) and (flat or step.jump or born):
         # A zone-only state with the solid passing through the indenter is none: a flat
-        # punch comes off, a smooth indenter's jump lands in contact instead.
+        # punch comes off, a smooth indenter's jump (or a zone born unstable) lands in
+        # contact instead.
         raise Lost("zone")
     return ev
 

@@ -658,8 +658,10 @@ class Stepper:
         try:
             ev = self.solve(step)
         except phases.Lost:
-            if kind == "in":
+            if kind == "in" and self._driver_rate() <= 0.0:
                 raise RuntimeError(f"no contact state to jump into at t = {now.t}") from None
+            # Retracting, a zone that ended while still growing has no contact to land in:
+            # it lets go (a DMT-like sphere's last zone).
             self.events.append((now.t, "jump_out"))
             now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
             self.events.append((now.t, "separated"))
