@@ -133,6 +133,22 @@ def test_dmt_like_sphere_matches_maugis_dugdale_and_tends_to_dmt(lam):
     assert res.F_pulloff / dmt > run(1.0).F_pulloff / dmt
 
 
+def test_sphere_behind_a_stiff_machine_spring_runs_the_path():
+    """Behind a spring the driver starts where it holds the indenter (it once started at 0, so
+    the tip leapt down and the path ended apart at once), and the zone's jump into contact
+    shows as a lost balance. A spring 1e4 times stiffer than the contact: the rigid machine's
+    pull-off (one level, n = 16: measured 2e-7 off Maugis-Dugdale's load-controlled value)."""
+    scene = load_scene(CONFIGS / "sphere_elastic.yaml",
+                       overrides=["loading.machine_stiffness=1e5"])
+    setup = contact_setup.setup(scene)
+    stepper = Stepper(setup, 16, contact._time_scale(scene, setup))
+    stepper.run(1e9)
+    s = contact.summarise(stepper)
+    assert s["F_max_compressive"] == pytest.approx(-2e-6, rel=1e-9)
+    load = ec.maugis_pulloff_force(R, G, 5e6, GAMMA, "load")
+    assert s["F_pulloff"] == pytest.approx(load, rel=1e-4)
+
+
 def test_kelvin_voigt_under_a_sphere_is_refused_before_work():
     with pytest.raises(SceneError) as info:
         path_scene(10.0, material={"kind": "kelvin_voigt", "G": 1e6, "eta": 1e3})

@@ -111,6 +111,8 @@ class Stepper:
             now.gap, now.F_contact, now.F_total = ev.gap, ev.F_contact, ev.F_total
         else:  # apart: the solid at rest, the gap is the tip's lift
             now.gap, now.centre_u = H0, 0.0
+        if s.machine is not None:  # the driver stands where the spring holds the indenter
+            now.driver = H0 + now.F_total / s.machine
         self._row(now)
         return now
 
@@ -610,7 +612,8 @@ class Stepper:
         if what == "advance":
             return self._jump("in")
         if what in ("separation", "zone", "balance"):
-            if what == "zone" and self._growing_zone():
+            if what in ("zone", "balance") and now.alpha == 0.0 and self._growing_zone():
+                # (behind a spring the zone's lost branch shows as a lost balance)
                 self._touch()
                 return self._jump("in")
             if what == "balance" and now.alpha > 0.0:
