@@ -99,7 +99,7 @@ def study(lines: list) -> None:
     import time
 
     from pulloff.references.onset import reference_detachment
-    from pulloff.io.scene_file import load_scene
+    from pulloff.io.scene_file import load_scene, override
     from pulloff.solvers import simulate
     from pulloff.solvers.problem import Problem
 

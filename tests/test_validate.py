@@ -2,10 +2,8 @@
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-from pulloff.model import analytic
 from pulloff.studies import validate as val
 from pulloff.cli import main
 
