@@ -122,12 +122,12 @@ def test_flat_punch_through_a_path_gives_the_pull_numbers():
 @pytest.mark.parametrize("lam", [0.1, 0.3])
 def test_dmt_like_sphere_matches_maugis_dugdale_and_tends_to_dmt(lam):
     """Small lambda: the zone is born stable and grows (no jump in), the contact is lost
-    continuously. Measured at rtol 1e-4: 2.3e-8 and 2.5e-7 off Maugis-Dugdale's load-
-    controlled pull-off; the ratio to DMT's 2 pi gamma R is 0.975 and 0.908 (0.800 at
-    lambda = 1), rising to 1 as lambda -> 0."""
-    res = run(lam)
+    continuously. Measured at rtol 1e-3: 1.6e-6 and 8.4e-7 off Maugis-Dugdale's load-
+    controlled pull-off (2.3e-8 and 2.5e-7 at rtol 1e-4); the ratio to DMT's 2 pi gamma R
+    is 0.975 and 0.908 (0.800 at lambda = 1), rising to 1 as lambda -> 0."""
+    res = solvers.simulate(path_scene(lam, rtol=1e-3))
     load = ec.maugis_pulloff_force(R, G, sigma_for(lam), GAMMA, "load")
-    assert res.F_pulloff == pytest.approx(load, rel=1e-4)
+    assert res.F_pulloff == pytest.approx(load, rel=1e-3)
     dmt = 2.0 * math.pi * GAMMA * R
     assert res.F_pulloff / dmt > {0.1: 0.97, 0.3: 0.9}[lam]
     assert res.F_pulloff / dmt > run(1.0).F_pulloff / dmt
