@@ -1650,8 +1650,14 @@ def flat_punch_reference(*, G_inf, eta=0.0, arms=(), sigma_c, delta, R, v, h0=0.
     scales = tuple(float(x) for x in scales)
     lv = [level] if level is not None else range(min_level, max_level + 1)
     tstart = _time.time()
-    results, levels, (est, rich, order, per) = _ladder(
+    results, levels, estimates = _ladder(
         params, scales, lv, N0, rtol, t_max, level is None, time_budget, tstart, verbose)
+    return _assemble(results, levels, estimates, scales, N0, tstart)
+
+
+def _assemble(results, levels, estimates, scales, N0, tstart) -> dict:
+    """The finest level's outputs with the ladder's estimates, levels and scales."""
+    est, rich, order, per = estimates
     out = dict(results[-1])
     out["error_estimate"] = est if len(results) >= 2 else float("nan")
     out["error_estimate_richardson"] = rich
