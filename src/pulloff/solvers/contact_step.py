@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kernels import contact as K
+from . import contact_state as st
 
 _TINY = 1e-13
 
@@ -69,6 +70,7 @@ class Step:
         self.before = before
         self.arm_mus = dt / law.tau_arms if law.maxwell else np.zeros(0)
         self.jump = False  # a zero-time transition: the phase's root is searched widely
+        self._free = None  # (x, modes) of the free elements at the start, gathered once
         self.k_alpha = self.k_beta = 0  # new elements per step (set by the stepper)
         self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv)
         setup = stepper.setup
@@ -121,12 +123,12 @@ class Step:
         if law.maxwell and self.jump and not self.s.setup.flat:
             # In a jump the dashpots do not move: an element the contact reaches keeps the
             # free state it had (virgin: none), and meets the indenter with the glassy modulus.
-            E = law.V @ self.s.free_modes_at(xi)
+            E = law.V @ self.free_modes_at(xi)
             return law.kappa_instant * (H_new + G) - float(np.dot(law.kappa_arms, E))
         if law.maxwell and xi > self.now.alpha and not self.s.setup.flat:
             # Beyond the contact the edge reaches a free element: its dashpots are where the
             # free side left them, relaxing toward the indenter from the step's start.
-            E = law.V @ self.s.free_modes_at(xi)
+            E = law.V @ self.free_modes_at(xi)
             D = E - self.now.Hf - self.s.setup.indenter.g(xi)
             memory = float(np.dot(law.kappa_arms, D * np.exp(-self.dt / law.tau_arms)))
             return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
@@ -136,6 +138,19 @@ class Step:
             return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
                     - memory)
         return law.kappa_inf * (H_new + G) + law.c * Hdot
+
+    def free_modes_at(self, x):
+        """Modes of a free element at ``x`` at the step's start: interpolated between the
+        free elements around it (zero in virgin solid, beyond every element). The free
+        elements are gathered once per step: the trials of a step share them."""
+        if self._free is None:
+            nodes = self.s.nodes
+            idx = np.nonzero(nodes.status[:nodes.n] == st.FREE)[0]
+            self._free = (nodes.xi[idx], nodes.Y[idx, :self.s.setup.law.n_modes])
+        xs, Ys = self._free
+        if xs.size == 0 or x > xs[-1]:
+            return np.zeros(Ys.shape[1])
+        return np.array([np.interp(x, xs, Ys[:, k]) for k in range(Ys.shape[1])])
 
     def released_modes(self, x, s_c, H_new):
         """Modes of a contact element at ``x`` released at fraction ``s_c``: its dashpots from

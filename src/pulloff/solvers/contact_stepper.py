@@ -143,17 +143,6 @@ class Stepper:
                   law.tau_arms, t, xi, out)
         return out
 
-    def free_modes_at(self, x):
-        """Modes of a free element at ``x`` now: interpolated between the free elements around
-        it (zero in virgin solid, beyond every element)."""
-        nodes = self.nodes
-        law = self.setup.law
-        idx = np.nonzero(nodes.status[:nodes.n] == st.FREE)[0]
-        if idx.size == 0 or x > nodes.xi[idx[-1]]:
-            return np.zeros(law.n_modes)
-        xs = nodes.xi[idx]
-        return np.array([np.interp(x, xs, nodes.Y[idx, k]) for k in range(law.n_modes)])
-
     def contact_memory(self, xi, t):
         """``sum_i kappa_i D_i e^{-(t - tj)/tau_i}``: the arms' memory in the contact load."""
         return float(np.dot(self.setup.law.kappa_arms, self.contact_memory_arms(xi, t)))
