@@ -92,6 +92,21 @@ def test_shipped_indenters_match_the_equilibrium_curve(config):
     assert res.error_estimate <= 1e-4
 
 
+@pytest.mark.parametrize("lam", [0.3, 1.0, 10.0])
+def test_jump_out_lands_on_the_fold_at_one_level(lam):
+    """The jump out is the fold of the branch, located by maximising the step over the edge
+    (or, DMT-like, the last zone's end), not by bisecting towards a double root: on an elastic
+    sphere it is Maugis-Dugdale's displacement-controlled pull-off at a single coarse level
+    (measured at n = 32: 1.4e-8, 6.7e-8, 5.4e-9; bisecting the step, as before, gave 3.8e-7,
+    1.5e-7, 7.3e-9 in thousands of evaluations per fold)."""
+    scene = path_scene(lam)
+    setup = contact_setup.setup(scene)
+    stepper = Stepper(setup, 32, contact._time_scale(scene, setup))
+    stepper.run(1e9)
+    leave = ec.maugis_pulloff_force(R, G, sigma_for(lam), GAMMA, "displacement")
+    assert contact.summarise(stepper)["F_jump_out"] == pytest.approx(leave, rel=3e-7)
+
+
 def test_pulloff_converges_with_the_step():
     """Fixed levels n = 16, 32, 64 on the lambda = 10 sphere: the pull-off force's level
     differences fall at order ~2.4 (measured 4.4e-6 then 8.4e-7 relative)."""

@@ -55,7 +55,7 @@ def _with_force(ev, force_residual):
 
 
 def _stick(step, H):
-    return step.evaluate(step.now.alpha, phases._edge_zone(step, H, step.now.alpha), H)
+    return step.evaluate(step.now.alpha, phases.edge_zone(step, H, step.now.alpha), H)
 
 
 def _force_scale(stepper, now):

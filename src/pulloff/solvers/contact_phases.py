@@ -22,6 +22,10 @@ class Lost(Exception):
 
 
 _XTOL = 1e-14
+#: How far a jump's search looks, in the larger of the last state, the predictor and the unit
+#: of length: a state ten thousand times further is no state of the scene (measured: without
+#: a bound, a tabulated tip's searches ran to 1e27 at 400 evaluations each).
+WIDE_REACH = 1e4
 
 
 def _secant(f, x_held, f_held, x_guess, lo, hi, reach):
@@ -93,8 +97,8 @@ def _root(f, x_held, f_held, x_guess, lo, hi, wide=False):
         return x_held
     first = 1.0 if x_guess >= x_held else -1.0
     reach = max(4.0 * abs(x_guess - x_held), 0.25 * max(abs(x_held), 1.0))
-    if wide:  # a jump: the new state may be anywhere
-        reach = math.inf
+    if wide:  # a jump: the new state may be far, but not beyond every scale of the scene
+        reach = WIDE_REACH * max(abs(x_held), abs(x_guess), 1.0)
     lo, hi = max(lo, x_held - reach), min(hi, x_held + reach)
     if x_guess != x_held:
         quick = _secant(f, x_held, f_held, x_guess, lo, hi, reach)
@@ -147,7 +151,7 @@ def _Hf(step, H):
     return step.filtered_lift(H) if law.maxwell else step.now.Hf
 
 
-def _edge_zone(step, H, alpha):
+def edge_zone(step, H, alpha):
     """The zone end the edge condition puts with the edge at ``alpha``."""
     Q = step.contact_load(alpha, H, step.lift_rate(H), _Hf(step, H))
     return math.hypot(alpha, max(Q, 0.0))
@@ -158,21 +162,21 @@ def receding(step, H, guess_alpha):
     now = step.now
 
     def residual(alpha):
-        return step.evaluate(alpha, _edge_zone(step, H, alpha), H).gap - 1.0
+        return step.evaluate(alpha, edge_zone(step, H, alpha), H).gap - 1.0
 
     r_held = residual(now.alpha)
     alpha = _root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha,
                   step.jump)
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
-    return step.evaluate(alpha, _edge_zone(step, H, alpha), H)
+    return step.evaluate(alpha, edge_zone(step, H, alpha), H)
 
 
 def flat_contact(step, H, guess_alpha):
     """A flat punch after the onset: the edge sticks while the gap stays below ``delta`` (the
     edge condition fixes ``b``), else it recedes; it never advances."""
     now = step.now
-    held = step.evaluate(now.alpha, _edge_zone(step, H, now.alpha), H)
+    held = step.evaluate(now.alpha, edge_zone(step, H, now.alpha), H)
     if held.gap <= 1.0:
         return held
     return receding(step, H, guess_alpha)
@@ -220,14 +224,14 @@ def smooth_contact(step, H, guess_alpha):
     now = step.now
 
     def residual(alpha):
-        return step.evaluate(alpha, _edge_zone(step, H, alpha), H).gap - 1.0
+        return step.evaluate(alpha, edge_zone(step, H, alpha), H).gap - 1.0
 
     start = max(now.alpha, 1e-12)
     alpha = _root(residual, start, residual(start), max(guess_alpha, 1e-12), 0.0, math.inf,
                   step.jump)
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
-    return step.evaluate(alpha, _edge_zone(step, H, alpha), H)
+    return step.evaluate(alpha, edge_zone(step, H, alpha), H)
 
 
 def apart(step, H):

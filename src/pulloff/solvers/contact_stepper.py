@@ -23,6 +23,7 @@ import numpy as np
 
 from ..kernels import contact as K
 from . import contact_balance as balance
+from . import contact_fold as fold
 from . import contact_phases as phases
 from . import contact_replay as replay
 from . import contact_state as st
@@ -453,6 +454,13 @@ class Stepper:
         if self._at_limit(what):
             self.transition(what)
             return
+        if fold.foldable(self, what):
+            found = fold.locate(self, dt, what)
+            if found is not None:
+                if found != fold.NOW:
+                    self.commit(*found)
+                self.transition(what)
+                return
         lo, hi = 0.0, dt
         best = None
         for _ in range(100):
@@ -611,6 +619,10 @@ class Stepper:
                 if now.phase in (st.BONDED, st.PINNED) and not any(
                         name == "onset" for _, name in self.events):
                     self.events.append((now.t, "onset"))
+                self.events.append((now.t, "jump_out"))
+            if what == "zone" and not self._at_limit("zone"):
+                # A zone alone whose branch folds while it still pulls (a DMT-like sphere's
+                # last zone): the force drops to zero at once, a jump.
                 self.events.append((now.t, "jump_out"))
             now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
             self.events.append((now.t, "separated"))
