@@ -40,6 +40,10 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
                 raise lost from None
             raise phases.Lost("balance")
         return out[0]
+    if now.phase == st.CONTACT_PHASE and not stepper.setup.flat:
+        both = _smooth_contact(stepper, step, H_guess, H_scale, force_residual, scale)
+        if both is not None:
+            return both
     if now.phase == st.CONTACT_PHASE and stepper.setup.flat:
         held = _newton(lambda z: _with_force(_stick(step, z[0]), force_residual),
                        np.array([H_guess]), H_scale, scale)
@@ -48,6 +52,31 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
                 return held[0]
             H_guess = held[0].H
     return _nested(stepper, step, H_guess, force_residual, H_travel)
+
+
+def _smooth_contact(stepper, step, H_guess, H_scale, force_residual, scale):
+    """A smooth indenter in contact: Newton on the edge and the lift together (the edge
+    condition fixes the zone end; ``gap(b) = delta`` and the force balance are the two
+    conditions), from the predictor; None where it does not converge, and the nested search
+    takes over."""
+    now = step.now
+    alpha_guess = stepper.guesses(step)[0]
+    if alpha_guess <= 0.0:
+        return None
+
+    def residual(z):
+        alpha, H = z
+        if alpha <= 0.0:
+            raise phases.Lost("contact")
+        ev = step.evaluate(alpha, phases.edge_zone(step, H, alpha), H)
+        return ev, np.array([ev.gap - 1.0, force_residual(ev)])
+
+    alpha_scale = max(abs(alpha_guess - now.alpha), 1e-6 * now.alpha, 1e-12)
+    out = _newton(residual, np.array([alpha_guess, H_guess]),
+                  np.array([alpha_scale, H_scale[0]]), np.array([1.0, scale[0]]))
+    if out is None or abs(out[0].alpha - now.alpha) > 0.25 * max(now.alpha, 1.0):
+        return None  # no state, or one on another branch
+    return out[0]
 
 
 def _with_force(ev, force_residual):

@@ -1,13 +1,15 @@
 """Where a smooth indenter's branch folds inside a step: the jump out of contact (the edge's
-branch ends) and the jump into it (a growing zone's branch ends), MODEL.md section 9.
+branch ends), the jump into it (a growing zone's branch ends), and a force-controlled pull-off
+(the force the branch can carry is passed), MODEL.md section 9.
 
 At a fold the state's unknown ``x`` (the edge ``alpha`` in contact, the zone end ``beta`` in the
 zone alone) stops being a function of the step length ``d``; but ``d`` stays a smooth function
-of ``x``: ``T(x)``, the step after which ``x`` satisfies the phase, has a quadratic maximum at
-the fold. So the fold is found by maximising ``T`` (each value a regular root in ``d``), not by
-bisecting ``d`` towards a double root, where every failed trial costs a full search for a root
-that is not there (measured: 1000-2000 evaluations per attempt, repeated as the committed steps
-crept towards the fold; here about 200).
+of ``x``: ``T(x)``, the step after which ``x`` satisfies the phase (and the force balance, where
+the lift is not prescribed), has a quadratic maximum at the fold. So the fold is found by
+maximising ``T`` (each value a regular root in ``d``), not by bisecting ``d`` towards a double
+root, where every failed trial costs a full search for a root that is not there (measured:
+1000-2000 evaluations per attempt under a prescribed lift, 20000 under force control, repeated
+as the committed steps crept towards the fold).
 """
 
 from __future__ import annotations
@@ -24,49 +26,83 @@ from . import contact_state as st
 _BRACKET = 0.02
 #: A branch whose longest working step is below this share of the trial step ends at once.
 _AT_ONCE = 1e-9
+#: The predictor's window reaches this many predicted moves of ``x`` past the last state.
+_AHEAD = 4.0
 NOW = "now"
 
 
 def foldable(stepper, what) -> bool:
     """Whether a lost branch is one this module locates: a smooth indenter's contact or zone
-    under a prescribed lift."""
+    alone."""
     phase = stepper.now.phase
-    return (not stepper.setup.flat and stepper.lift_driven
-            and ((what == "contact" and phase == st.CONTACT_PHASE)
-                 or (what == "zone" and phase == st.ZONE)))
+    return (not stepper.setup.flat and what in ("contact", "zone", "balance")
+            and phase in (st.CONTACT_PHASE, st.ZONE))
 
 
 def locate(stepper, dt, what):
     """``(step, evaluation)`` at the fold inside a step of ``dt`` (the state just before the
     branch ends); ``NOW`` where the branch ends at once; None where the fold is not a clean
     maximum of ``T`` (the caller then bisects)."""
+    x_now = _unknown(stepper, stepper.now)
+    window = _predicted_window(stepper, dt, x_now)
+    if window is not None:
+        found = _maximise(stepper, window, 1e-9 * dt, dt, 0.0)
+        if found is not None:
+            return found
     near = _near_fold(stepper, dt)
     if near is None or near == NOW:
         return near
     d_ok, x_ok, d_lost = near
-    x_now = stepper.now.alpha if what == "contact" else stepper.now.beta
     half = 0.5 * abs(x_ok - x_now)
     if half == 0.0:
         return None
-    tiny = 1e-9 * d_ok
+    return _maximise(stepper, (max(x_ok - half, 0.0), x_ok + half), 1e-9 * d_ok, d_lost, d_ok)
+
+
+def _unknown(stepper, state) -> float:
+    return state.alpha if stepper.now.phase == st.CONTACT_PHASE else state.beta
+
+
+def _predicted_window(stepper, dt, x_now):
+    """From the last state to ``_AHEAD`` predicted moves of ``x`` over ``dt`` beyond it (the
+    last step's rate), or None without a last step."""
+    now, before = stepper.now, stepper.before
+    if before is None or now.t <= before.t:
+        return None
+    move = (x_now - _unknown(stepper, before)) * dt / (now.t - before.t)
+    if move == 0.0 or not math.isfinite(move):
+        return None
+    ends = (x_now, x_now + _AHEAD * move)
+    return max(min(ends), 0.0), max(ends)
+
+
+def _maximise(stepper, window, tiny, d_lost, d_ok):
+    """The fold as the maximum of ``T`` over ``window``: ``(step, evaluation)``, or None where
+    the maximum lies on the window's edge or below ``d_ok`` (not the fold looked for)."""
+    lo, hi = window
 
     def steps_to(x):
-        """T(x): the step length after which ``x`` holds (0 where no step up to the lost one
-        reaches it: beyond the branch)."""
-        r_lo, r_hi = _residual(stepper, what, x, tiny)[0], _residual(stepper, what, x, d_lost)[0]
+        """T(x): the step after which ``x`` holds (0 where no step up to ``d_lost`` reaches
+        it: beyond the branch)."""
+        r_lo = _residual(stepper, x, tiny)[0]
+        r_hi = _residual(stepper, x, d_lost)[0]
         if not (math.isfinite(r_lo) and math.isfinite(r_hi)) or (r_lo > 0.0) == (r_hi > 0.0):
             return 0.0
-        return brentq(lambda d: _residual(stepper, what, x, d)[0], tiny, d_lost,
+        return brentq(lambda d: _residual(stepper, x, d)[0], tiny, d_lost,
                       xtol=1e-15 * d_lost, rtol=1e-15)
 
-    lo = max(x_ok - half, 0.0)
-    best = minimize_scalar(lambda x: -steps_to(x), bounds=(lo, x_ok + half), method="bounded",
-                           options={"xatol": 1e-12 * max(abs(x_ok), 1.0)})
+    best = minimize_scalar(lambda x: -steps_to(x), bounds=(lo, hi), method="bounded",
+                           options={"xatol": 1e-12 * max(abs(hi), 1.0)})
     x_fold = float(best.x)
+    margin = 1e-3 * (hi - lo)
+    if not lo + margin < x_fold < hi - margin:
+        return None
     d_fold = steps_to(x_fold)
-    if not d_ok * (1.0 - 1e-9) <= d_fold < d_lost:
-        return None  # not the maximum the bisection bracketed: another branch
-    _, step, ev = _residual(stepper, what, x_fold, d_fold)
+    if not (d_fold > 0.0 and d_ok * (1.0 - 1e-9) <= d_fold < d_lost):
+        return None
+    _, step, ev = _residual(stepper, x_fold, d_fold)
+    if ev is None or stepper.crossed(ev) is not None:
+        return None  # an event comes first: the caller lands on it
     return step, ev
 
 
@@ -88,19 +124,35 @@ def _near_fold(stepper, dt):
         else:
             if stepper.crossed(ev) is not None:
                 return None
-            lo, x_lo = mid, (ev.alpha if stepper.now.phase == st.CONTACT_PHASE else ev.beta)
+            lo, x_lo = mid, _unknown(stepper, ev)
         if x_lo is not None and hi - lo <= _BRACKET * hi:
             return lo, x_lo, hi
     return None
 
 
-def _residual(stepper, what, x, d):
-    """``gap(b)/delta - 1`` after a step of ``d`` with the phase's unknown at ``x``, and the
-    step and evaluation."""
+def _residual(stepper, x, d):
+    """After a step of ``d`` with the phase's unknown at ``x``: the remaining condition
+    (``gap(b)/delta - 1`` under a prescribed lift, the force balance otherwise, with the lift
+    from ``gap(b) = delta``), the step and the evaluation (nan, None where no lift fits)."""
     step = stepper.make_step(d)
-    H = stepper.now.H + (stepper.drive.rate * d if stepper.drive.kind == "speed" else 0.0)
-    if what == "contact":
-        ev = step.evaluate(x, phases.edge_zone(step, H, x), H)
-    else:
-        ev = step.evaluate(0.0, x, H)
-    return ev.gap - 1.0, step, ev
+    if stepper.lift_driven:
+        H = stepper.now.H + (stepper.drive.rate * d if stepper.drive.kind == "speed" else 0.0)
+        ev = _evaluate(stepper, step, x, H)
+        return ev.gap - 1.0, step, ev
+    now = stepper.now
+
+    def gap_left(H):
+        return _evaluate(stepper, step, x, H).gap - 1.0
+
+    rate = now.Hdot if math.isfinite(now.Hdot) else 0.0
+    H = phases._root(gap_left, now.H, gap_left(now.H), now.H + rate * d, -math.inf, math.inf)
+    if H is None:
+        return math.nan, step, None
+    ev = _evaluate(stepper, step, x, H)
+    return stepper.force_residual(d)(ev), step, ev
+
+
+def _evaluate(stepper, step, x, H):
+    if stepper.now.phase == st.CONTACT_PHASE:
+        return step.evaluate(x, phases.edge_zone(step, H, x), H)
+    return step.evaluate(0.0, x, H)

@@ -293,13 +293,18 @@ class Stepper:
             return self._phase(step, H)
         return self._balanced(step)
 
-    def _phase(self, step, H) -> Evaluation:
+    def guesses(self, step) -> tuple[float, float]:
+        """The edge and the zone end at the end of ``step`` extrapolated from the last step."""
         now, before = self.now, self.before
-        guess_a, guess_b = now.alpha, now.beta
-        if before is not None and now.t > before.t:
-            f = step.dt / (now.t - before.t)
-            guess_a = max(now.alpha + f * (now.alpha - before.alpha), 0.0)
-            guess_b = max(now.beta + f * (now.beta - before.beta), 0.0)
+        if before is None or now.t <= before.t:
+            return now.alpha, now.beta
+        f = step.dt / (now.t - before.t)
+        return (max(now.alpha + f * (now.alpha - before.alpha), 0.0),
+                max(now.beta + f * (now.beta - before.beta), 0.0))
+
+    def _phase(self, step, H) -> Evaluation:
+        now = self.now
+        guess_a, guess_b = self.guesses(step)
         phase = now.phase
         if phase == st.BONDED:
             return phases.bonded(step, H)
@@ -313,22 +318,23 @@ class Stepper:
             return phases.zone_only(step, H, guess_b)
         return phases.apart(step, H)
 
+    def force_residual(self, dt):
+        """The force balance at the end of a step of ``dt`` behind the machine spring or under
+        the driven force, as a function of the evaluation there (zero when it holds)."""
+        s, now, drive = self.setup, self.now, self.drive
+        if s.machine is not None:
+            driver = now.driver + drive.rate * dt
+            return lambda ev: s.machine * (driver - ev.H) - ev.F_total
+        target = now.F_total + (drive.rate * dt if drive.kind == "force_rate" else 0.0)
+        return lambda ev: target - ev.F_total
+
     def _balanced(self, step) -> Evaluation:
         """The lift at the end of the step balances the machine spring or the driven force:
         Newton on the lift and the phase's own unknown together."""
         s = self.setup
         now = self.now
         drive = self.drive
-        if s.machine is not None:
-            driver = now.driver + drive.rate * step.dt
-
-            def force_residual(ev):
-                return s.machine * (driver - ev.H) - ev.F_total
-        else:
-            target = now.F_total + (drive.rate * step.dt if drive.kind == "force_rate" else 0.0)
-
-            def force_residual(ev):
-                return target - ev.F_total
+        force_residual = self.force_residual(step.dt)
         # After an event the paths restart; the lift's rate still carries over (a viscous
         # solid's force follows the rate: a short step tolerates only a narrow lift).
         rate = now.Hdot if math.isfinite(now.Hdot) else 0.0
