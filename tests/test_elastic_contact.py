@@ -576,3 +576,27 @@ def test_cone_released_without_jump_in_the_rigid_limit():
     p, kw = PROFILES["cone"], dict(sigma_c=1e5, delta=1e-6)
     dc = E.mdr_dugdale_pulloff(p, 1e9, **kw, control="displacement")
     assert dc.branch == "zone-only" and dc.F == 0.0 and dc.h == pytest.approx(1e-6, rel=1e-15)
+
+
+def test_spring_jump_out_lies_between_the_rigid_and_the_load_controlled_pull_off():
+    """Behind a spring k the curve is left where ``h + F/k`` turns: ``dF/dh = -k`` there (checked
+    by differences along the curve), tending to the rigid machine's jump out as k -> inf and to
+    the load-controlled pull-off as k -> 0 (both monotonically)."""
+    R, G, sigma_c, gamma = 1e-5, 1e6, 5e6, 0.05
+    profile = E.sphere_profile(R)
+    kw = dict(sigma_c=sigma_c, gamma=gamma)
+    rigid = E.mdr_dugdale_pulloff(profile, G, control="displacement", **kw).F
+    load = E.mdr_dugdale_pulloff(profile, G, control="load", **kw).F
+    forces = []
+    for k in (1e6, 1e2, 1.0, 1e-3):
+        leave = E.mdr_dugdale_pulloff(profile, G, control="displacement", machine_stiffness=k,
+                                      **kw)
+        forces.append(leave.F)
+        da = 1e-5 * leave.a
+        up, down = (E.equilibrium_at_contact_radius(leave.a + s * da, profile, G, **kw)
+                    for s in (1.0, -1.0))
+        slope = (up.F_total - down.F_total) / (up.h - down.h)
+        assert slope == pytest.approx(-k, rel=1e-4)
+    assert rigid < forces[0] < forces[1] < forces[2] < forces[3] < load
+    assert forces[0] == pytest.approx(rigid, rel=1e-3)
+    assert forces[3] == pytest.approx(load, rel=1e-6)

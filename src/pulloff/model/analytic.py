@@ -647,12 +647,15 @@ def path_predictions(scene) -> dict:
                 out[f"{key}_F_pulloff"] = ec.mdr_dugdale_pulloff(
                     profile, modulus, sigma_c=sigma_c, delta=delta, control="load").F
         return out
+    machine = getattr(scene.loading, "machine_stiffness", None)
     for control in ("load", "displacement"):
         out[f"mdr_dugdale_F_pulloff_{control}"] = ec.mdr_dugdale_pulloff(
-            profile, G, sigma_c=sigma_c, delta=delta, control=control).F
+            profile, G, sigma_c=sigma_c, delta=delta, control=control,
+            machine_stiffness=machine).F
     out["jkr_F_pulloff_load"] = ec.jkr_pulloff(profile, 4.0 * G, gamma, "load").F
     if geometry.kind == "sphere":
-        for control in ("load", "displacement"):
+        # (Maugis' displacement control is a rigid machine's: not a spring's)
+        for control in ("load",) if machine else ("load", "displacement"):
             out[f"maugis_F_pulloff_{control}"] = ec.maugis_pulloff_force(
                 geometry.radius, G, sigma_c, gamma, control)
     return out

@@ -684,7 +684,7 @@ def _contact_scale(profile, G, gamma, b0):
 
 
 def mdr_dugdale_pulloff(profile, G, *, sigma_c=None, delta=None, gamma=None, control="load",
-                        a_max=None, n=160):
+                        a_max=None, n=160, machine_stiffness=None):
     """Pull-off of the elastic MDR-Dugdale model for any (monotone) profile: :class:`PullOff`
     ``(F [N], h [m], a [m], b [m], branch)``, G [Pa], two of sigma_c [Pa], delta [m], gamma
     [J/m^2].
@@ -695,6 +695,9 @@ def mdr_dugdale_pulloff(profile, G, *, sigma_c=None, delta=None, gamma=None, con
     ``a`` with ``dh/da = 0``; if ``h`` rises all the way to the join, the zone-only branch is
     followed while ``f'(b) > sigma_c/(pi G)`` and left where that fails (``dh/db = 0``), at the
     join if it fails there already, or at ``b = 0`` (``F = 0``, a continuous release).
+    Behind a machine spring of ``machine_stiffness`` [N/m] (displacement control) it is the
+    driver ``h + F/k`` that turns: the spring and the curve lose stability together, where
+    ``dF/dh = -k`` (nan if that happens beyond the contact branch).
     The contact branch is sampled at ``n`` radii from a_max (default: :func:`_contact_scale`)
     down to 1e-6 of the smaller of the JKR and join scales, then refined by a root of the
     5-point derivative in ``log a`` (each point an exact equilibrium): measured agreement with
@@ -720,9 +723,9 @@ def mdr_dugdale_pulloff(profile, G, *, sigma_c=None, delta=None, gamma=None, con
         s = state(x)
         return PullOff(s.F_total, s.h, x, s.b, branch)
 
-    def refine(i, key):
+    def refine(i, quantity):
         lo = math.log(a[i + 1]) if i + 1 < n else math.log(a[i]) - 7.0
-        y = _refine(lambda y: _dlog(lambda x: getattr(state(x), key), math.exp(y)),
+        y = _refine(lambda y: _dlog(lambda x: quantity(state(x)), math.exp(y)),
                     lo, math.log(a[i - 1]), math.log(a[i]))
         return at(math.exp(y), "contact")
 
@@ -737,17 +740,24 @@ def mdr_dugdale_pulloff(profile, G, *, sigma_c=None, delta=None, gamma=None, con
             lo, hi = a[min(i + 2, n - 1)], a[max(i - 2, 0)]
             return at(_faceted_peak(lambda x: state(x).F_total, lo, hi, profile.r_table),
                       "contact")
-        return refine(i, "F_total")
+        return refine(i, lambda s: s.F_total)
     if control != "displacement":
         raise ValueError("control: 'load' or 'displacement'")
     # h = sigma_c c/(2G) - g(a) is rounded at ~eps (|h| + 2 g(a)); near the join
     # h - h_join = O(a^2) for a sphere sinks below that, hence the tolerance
-    h = np.append(cs.h, join.h)
+    compliance = 0.0 if machine_stiffness is None else 1.0 / machine_stiffness
+
+    def driver(s):
+        return s.h + compliance * s.F_total
+
+    h = np.append(driver(cs), driver(join))
     i = _first_turn(h, np.abs(h) + 2.0 * np.append(profile.g(a), 0.0))
     if i == 0:
         raise ValueError("lift already falls at a_max: raise a_max")
     if i is not None and i < n:
-        return refine(i, "h")
+        return refine(i, driver)
+    if compliance:
+        return PullOff(math.nan, math.nan, math.nan, math.nan, "beyond contact")
     return _zone_only_departure(profile, G, sigma_c, delta, b0)
 
 

@@ -124,14 +124,16 @@ OUTPUTS = (
                                           "profile (an independent semi-analytic solution)",
        "elastic_path"),
     _a("mdr_dugdale_F_pulloff_displacement", "N", "the same under displacement control (where "
-                                                  "a rigid lift leaves the curve)",
+                                                  "a rigid lift leaves the curve; behind a "
+                                                  "machine spring, where the driver does)",
        "elastic_path"),
     _a("jkr_F_pulloff_load", "N", "JKR pull-off under load control (the limit of an infinitely "
                                   "strong, short-ranged adhesion)", "elastic_path"),
     _a("maugis_F_pulloff_load", "N", "Maugis-Dugdale pull-off of a sphere, load control",
        "sphere"),
     _a("maugis_F_pulloff_displacement", "N", "Maugis-Dugdale pull-off of a sphere, "
-                                             "displacement control", "sphere"),
+                                             "displacement control by a rigid machine",
+       "sphere"),
     _a("relaxed_F_pulloff", "N", "the largest tensile force of the elastic MDR-Dugdale curve "
                                  "with the relaxed modulus G_inf: a slow retraction's limit",
        "memory_path"),

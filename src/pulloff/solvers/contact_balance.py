@@ -113,8 +113,10 @@ def _nested(stepper, step, H_guess, force_residual, H_travel):
     # The first trial is a small part of the lift's travel over the step: a short step of a
     # viscous solid balances only in a narrow window of lifts.
     probe = max(1e-3 * H_travel, 1e-12 * max(abs(H_guess), 1.0))
+    # A jump behind a soft spring moves the indenter too (by F/k): its lift is searched as
+    # widely as the jump's edge.
     H = phases._root(residual, H_guess, r0, H_guess + min(probe, 1e-9 * max(abs(H_guess), 1.0)),
-                     -math.inf, math.inf)
+                     -math.inf, math.inf, step.jump)
     if H is None:
         raise phases.Lost("balance")
     return cache.get(H) or stepper._phase(step, H)
