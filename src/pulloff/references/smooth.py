@@ -4,8 +4,9 @@
 MODEL.md sections 1, 2, 6 and 9: a rigid sphere (``f = r^2/(2R)``, MDR profile ``g = x^2/R``)
 under displacement control (rigid machine) approaches a linear visco-elastic half-space from
 ``h0`` at speed ``v_in`` until the total force reaches ``-F_target`` (compressive), then
-retracts at ``v_out`` until complete separation. It imports nothing from the rest of
-``pulloff`` and shares no code with the project's solvers.
+retracts at ``v_out`` until complete separation; or (``force_rate``) retracts under force
+control, ``F(t) = -F_target + force_rate (t - t_turn)``, to the force-controlled pull-off. It
+imports nothing from the rest of ``pulloff`` and shares no code with the project's solvers.
 
 Units: SI throughout (m, s, Pa, N, N/m).
 
@@ -39,6 +40,28 @@ Method
 * The force target at the turn is hit exactly (root in the step size). ``F_pulloff`` is the
   largest tensile force of the retraction, refined by a parabola through the three samples
   around the largest one.
+
+Force-controlled retraction (``force_rate``)
+--------------------------------------------
+* Same model, grid, moving nodes and arm update; the lift ``h`` is an extra unknown of each
+  step. For a step ``dt`` (history fixed) the states are parametrised by the contact radius
+  ``a``: the edge condition gives the lift explicitly, ``h(a, b) = (sigma sqrt(b^2 - a^2)/2 +
+  hist(a))/Geff - a^2/R``, and ``gap(b) = delta`` (``-delta`` at ``b = a``, increasing) fixes
+  ``b(a)``; so ``F(a)`` is one smooth function. The step's state is the root of
+  ``F(a) = F_prescribed(t + dt)`` on the stable side (``dF/da < 0``) nearest the last ``a``:
+  Newton on ``(a, b)`` from a linear predictor (accepted only on the stable side, within a
+  window), else a walk from the last ``a`` with bracketing (Brent).
+* Fold (pull-off): if the walk passes the local maximum of ``F(a)`` (refined by bounded
+  Brent) and it is below the prescribed force, no state carries it within this step. The fold
+  time is then the root ``dt*`` in ``[0, dt]`` of ``S(dt) = max_a F(a; dt) - F_prescribed(dt)``
+  (Brent, ``xtol`` 1e-15 of the time; ``S(0) > 0`` as the last state is stable). This is the
+  same as maximising over ``a`` the time at which ``a`` balances the prescribed force.
+  ``F_pulloff`` is the prescribed force at ``t_turn + dt*``; ``h_pulloff``/``a_pulloff`` are of
+  the maximising state (a flat maximum: ~1e-8 relative, the force to round-off).
+* Step control: nominal ``dt = dF/force_rate``; edges may move at most ``kappa`` zone widths
+  per step, ``kappa = dt/min(tau_i)`` (no limit when elastic), also for the fold step, so the
+  fold is closed in on with shrinking steps (last step ~1e-6 s at dt = 6e-5 s). Only
+  contact states are followed (an error if the contact is lost before the fold).
 """
 from __future__ import annotations
 
@@ -161,6 +184,44 @@ class _Step:
             r_a = math.sqrt(max((b - a) * (b + a), 0.0))
             th_a = math.atan2(r_a, a)
             F += 2.0 * m.sigma * (b * b * th_a - a * r_a)
+        return F
+
+    # --- force control: the lift as an unknown (contact states, a > 0) -----------------------
+    def h_edge(self, a, b):
+        """Lift at which the contact edge a carries the zone b (edge condition solved for h)."""
+        return ((0.5 * self.m.sigma * math.sqrt(max((b - a) * (b + a), 0.0)) + self.hist_at(a))
+                / self.Geff - a * a / self.m.R)
+
+    def gap_at(self, a, b, h):
+        """``gap(b) - delta`` for contact radius a, zone end b and lift h (``phi`` with h given)."""
+        m = self.m
+        if b <= a:
+            return -m.delta
+        r_a = math.sqrt(max((b - a) * (b + a), 0.0))
+        asin_ab = 0.5 * math.pi - math.atan2(r_a, a)
+        C = h * asin_ab + (0.5 * b * b * asin_ab - 0.5 * a * r_a) / m.R
+        u3d = (2.0 / math.pi) * (C + (0.5 * m.sigma * (b - a) + self.Hint(a, b)) / self.Geff)
+        return h + 0.5 * b * b / m.R - u3d - m.delta
+
+    def hist_integral(self, a):
+        """int_0^a hist dx (exact for the piecewise linear hist), via a cumulative table."""
+        if self.elastic:
+            return 0.0
+        if not hasattr(self, "_cum"):
+            self._cum = np.concatenate(([0.0], np.cumsum(0.5 * (self.Hm[1:] + self.Hm[:-1])
+                                                         * np.diff(self.Xm))))
+        i = int(np.searchsorted(self.Xm, a, side="right")) - 1
+        i = min(max(i, 0), len(self.Xm) - 2)
+        x0 = self.Xm[i]
+        return float(self._cum[i] + 0.5 * (self.Hm[i] + self.hist_at(a)) * (a - x0))
+
+    def force_at(self, a, b, h):
+        """Total force [N] of the contact state (a, b) at lift h (``force`` with h given)."""
+        m = self.m
+        F = 8.0 * (self.Geff * (h * a + a ** 3 / (3.0 * m.R)) - self.hist_integral(a))
+        if b > a:
+            r_a = math.sqrt(max((b - a) * (b + a), 0.0))
+            F += 2.0 * m.sigma * (b * b * math.atan2(r_a, a) - a * r_a)
         return F
 
 
@@ -429,6 +490,262 @@ def _march(sol, h0, segments, delta, F_target, max_steps):
     return rec, jumps
 
 
+class _ContactStates:
+    """Contact states of one force-controlled step (fixed ``dt``, hence fixed history): for a
+    contact radius ``a`` the zone end ``b`` solves ``gap(b) = delta`` with the lift given by the
+    edge condition at ``a``, ``h = (sigma sqrt(b^2 - a^2)/2 + hist(a))/Geff - a^2/R``; returns
+    ``(b, h, F)`` (cached)."""
+
+    def __init__(self, st, w_guess, xmax):
+        self.st = st
+        self.w = max(w_guess, 1e-9 * xmax)
+        self.xmax = xmax
+        self.cache = {}
+
+    def __call__(self, a):
+        v = self.cache.get(a)
+        if v is None:
+            st = self.st
+
+            def g(b):
+                return st.gap_at(a, b, st.h_edge(a, b))
+
+            lo, w = a, 0.25 * self.w  # g(a) = -delta
+            while True:
+                hi = a + w
+                if hi >= self.xmax:
+                    raise RuntimeError("zone end beyond x_max; increase x_max")
+                if g(hi) > 0.0:
+                    break
+                lo, w = hi, 2.0 * w
+            b = brentq(g, lo, hi, xtol=1e-15 * self.xmax, rtol=1e-15, maxiter=200)
+            h = st.h_edge(a, b)
+            v = (b, h, st.force_at(a, b, h))
+            self.cache[a] = v
+        return v
+
+
+def _force_newton(st, Ft, a_pred, b_pred, a0, W, xmax):
+    """Newton (chord) solve of ``gap = delta`` and ``F = Ft`` for ``(a, b)`` from a predictor,
+    the lift from the edge condition; ``(a, b)`` on the stable branch (``dF/da < 0`` along
+    ``gap = delta``) within ``W`` of ``a0``, or None (then the walk decides)."""
+    Fs = abs(Ft) + 2.0 * st.m.sigma * st.m.delta * st.m.R  # force scale of the residual
+
+    def res(a, b):
+        if not 0.0 < a < b < xmax:
+            raise _Fail
+        h = st.h_edge(a, b)
+        return np.array([st.gap_at(a, b, h) / st.m.delta, (st.force_at(a, b, h) - Ft) / Fs])
+
+    def jac(a, b, r):
+        e = 1e-7 * (b - a)
+        ra = res(a + e, b)
+        rb = res(a, b + e)
+        return np.column_stack(((ra - r) / e, (rb - r) / e))
+
+    try:
+        a, b = a_pred, b_pred
+        r = res(a, b)
+        J = jac(a, b, r)
+        tol = 1e-14 * a0
+        for it in range(16):
+            if it == 8:
+                J = jac(a, b, r)
+            da, db = np.linalg.solve(J, -r)
+            a, b = a + da, b + db
+            r = res(a, b)
+            if abs(da) <= tol and abs(db) <= tol:
+                break
+        else:
+            return None
+        J = jac(a, b, r)
+    except (_Fail, np.linalg.LinAlgError):
+        return None
+    if abs(a - a0) > W or not np.all(np.isfinite(J)):
+        return None
+    if J[1, 0] - J[1, 1] * J[0, 0] / J[0, 1] >= 0.0:
+        return None  # unstable side of the fold
+    return float(a), float(b)
+
+
+def _force_max(ev, a0, step, W):
+    """Local maximum of ``F(a) = ev(a)[2]`` nearest ``a0`` (walk uphill with doubling steps,
+    then bounded Brent on the bracketing triple): ``(a_m, F_m)``; ``_Fail`` beyond ``W``."""
+    def f(a):
+        if a <= 0.0:
+            raise NotImplementedError("contact lost before the force-controlled pull-off")
+        return ev(a)[2]
+
+    f0 = f(a0)
+    d = -1.0
+    f1 = f(a0 - step)
+    walk = True
+    if f1 < f0:
+        d = 1.0
+        f1 = f(a0 + step)
+        if f1 <= f0:
+            lo, hi = a0 - step, a0 + step
+            walk = False
+    if walk:
+        pp, ap, fp = a0, a0 + d * step, f1
+        while True:
+            step *= 2.0
+            an = ap + d * step
+            if abs(an - a0) > W:
+                raise _Fail
+            fn = f(an)
+            if fn <= fp:
+                lo, hi = min(pp, an), max(pp, an)
+                break
+            pp, ap, fp = ap, an, fn
+    res = minimize_scalar(lambda x: -f(x), bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-13 * a0})
+    return float(res.x), float(-res.fun)
+
+
+def _force_step(ev, Ft, a0, step, W, xtol):
+    """Stable contact state (``dF/da < 0``) nearest ``a0`` carrying the force ``Ft``:
+    ``("ok", a)``, or ``("fold", a_m, F_m)`` if the local maximum ``F_m`` of ``F(a)`` is below
+    ``Ft``; ``_Fail`` if neither is found within ``W`` of ``a0``."""
+    def g(a):
+        if a <= 0.0:
+            raise NotImplementedError("contact lost before the force-controlled pull-off")
+        return ev(a)[2] - Ft
+
+    def root(lo, hi):
+        return ("ok", brentq(g, lo, hi, xtol=xtol, rtol=1e-15, maxiter=200))
+
+    g0 = g(a0)
+    if g0 == 0.0:
+        return ("ok", a0)
+    d = step
+    if g0 > 0.0:  # too much tension at a0: the contact grows (F decreases with a)
+        pp, gp = a0, g0
+        while True:
+            an = pp + d
+            if an - a0 > W:
+                raise _Fail
+            gn = g(an)
+            if gn <= 0.0:
+                return root(pp, an)
+            if gn > gp:
+                raise _Fail
+            pp, gp, d = an, gn, 2.0 * d
+    pts = [(a0, g0)]
+    while True:  # the contact shrinks until F reaches Ft, or F passes its maximum
+        an = pts[-1][0] - d
+        if a0 - an > W:
+            raise _Fail
+        gn = g(an)
+        if gn >= 0.0:
+            return root(an, pts[-1][0])
+        if gn < pts[-1][1]:
+            break
+        pts.append((an, gn))
+        d *= 2.0
+    a_m, F_m = _force_max(ev, pts[-1][0], step, W)
+    if F_m < Ft:
+        return ("fold", a_m, F_m)
+    above = [a for a, _ in pts if a > a_m]
+    if not above:
+        raise _Fail
+    return root(a_m, min(above))
+
+
+def _fold_in_step(make, Fpres, w, a0, step, W, dtry, t_end):
+    """The fold inside a step of ``dtry``: the root of ``S(dt) = max_a F(a; dt) -
+    F_prescribed(dt)`` on ``[0, dtry]``; returns the step, its states, the fold's ``a`` and the
+    step length."""
+    def S(dt):
+        return _force_max(make(dt, w)[1], a0, step, W)[1] - Fpres(dt)
+
+    dts = 0.0 if S(0.0) <= 0.0 else brentq(S, 0.0, dtry, xtol=1e-15 * t_end, rtol=1e-15,
+                                           maxiter=200)
+    st, ev = make(dts, w)
+    return st, ev, _force_max(ev, a0, step, W)[0], dts
+
+
+def _retract_force(sol, rec, F_target, rate, dtn, kappa, max_steps):
+    """Force-controlled retraction ``F = -F_target + rate (t - t_turn)`` from the turn to the
+    fold (pull-off); appends to ``rec``; returns the fold (dict)."""
+    t_turn = rec["t"][-1]
+    if sol.mode != "contact":
+        raise RuntimeError("force control needs contact at the turn")
+    xmax = sol.X[-1]
+    s = 0.0  # time since the turn
+    dtry = dtn
+    dt_min = 1e-10 * dtn
+    da_prev = 0.0
+    merged = sol.merged()
+    nsteps = 0
+    pred = None  # (da, db, dt) of the last step: the Newton predictor
+
+    def make(dt, w):
+        st = _Step(sol.m, *merged, 0.0, dt, sol.tol_x)
+        return st, _ContactStates(st, w, xmax)
+
+    def Fpres(dt):
+        return -F_target + rate * (s + dt)
+
+    while True:
+        nsteps += 1
+        if nsteps > max_steps:
+            raise RuntimeError("too many steps")
+        a0, b0 = sol.a, sol.b
+        w = b0 - a0
+        step = 1.2 * abs(da_prev) + w / 64.0
+        W = 4.0 * sol.dx + 8.0 * w + 4.0 * abs(da_prev)
+        xtol = 1e-15 * xmax
+        st, ev = make(dtry, w)
+        nw = None
+        if pred is not None:
+            q = dtry / pred[2]
+            nw = _force_newton(st, Fpres(dtry), a0 + q * pred[0], b0 + q * pred[1], a0, W, xmax)
+        if nw is not None:
+            res = ("ok", nw[0])
+        else:
+            try:
+                res = _force_step(ev, Fpres(dtry), a0, step, W, xtol)
+            except _Fail:
+                if dtry > dt_min:
+                    dtry *= 0.5
+                    continue
+                raise RuntimeError("force-controlled step failed (no state near the last one)")
+        fold = res[0] == "fold"
+        if fold:
+            st, ev, a, dt_step = _fold_in_step(make, Fpres, w, a0, step, W, dtry,
+                                               t_turn + s + dtry)
+            b, h, F = ev(a)
+        elif nw is not None:
+            a, b = nw
+            dt_step = dtry
+            h = st.h_edge(a, b)
+            F = st.force_at(a, b, h)
+        else:
+            a = res[1]
+            dt_step = dtry
+            b, h, F = ev(a)
+        ell = max(abs(a - a0), abs(b - b0)) / (kappa * w) if math.isfinite(kappa) else 0.0
+        if ell > 1.5 and dt_step > dt_min:
+            # edges may move at most kappa zone widths per step (also when closing on the fold)
+            dtry = max(dt_step * min(0.5, 0.8 / ell), dt_min)
+            continue
+        grow = min(2.0, 0.9 / ell) if ell > 0 else 2.0
+        sol.commit(dict(st=st, p=a, p0=a0, a=a, b=b, mode="contact", F=F, Xm=merged[0],
+                        Um=merged[1], Sm=merged[2], h=h, dt=dt_step))
+        s += dt_step
+        for key, val in (("t", t_turn + s), ("h", h), ("F", F), ("a", a), ("b", b),
+                         ("mode", "contact"), ("segment", 1)):
+            rec[key].append(val)
+        if fold:
+            return dict(s=s, t=t_turn + s, F=-F_target + rate * s, F_state=F, h=h, a=a, b=b,
+                        t_turn=t_turn, last_step=dt_step, n_steps=nsteps)
+        merged = sol.merged()
+        da_prev = a - a0
+        pred = (a - a0, b - b0, dt_step) if dt_step > 0.0 else None
+        dtry = min(max(grow, 0.5) * dt_step, dtn)
+
+
 def _summary(out, jumps) -> dict:
     """Pull-off (parabola-refined), jump out, contact loss, jump in and extent (SI)."""
     res = {}
@@ -472,9 +789,9 @@ def _summary(out, jumps) -> dict:
     return res
 
 
-def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_target, v_out,
+def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_target, v_out=None,
                           n_elements, dt=None, dt_in=None, dh=None, x_max=None,
-                          max_steps=10_000_000):
+                          max_steps=10_000_000, force_rate=None, dF=None):
     """Approach-retract cycle of a rigid sphere on an MDR-Dugdale visco-elastic half-space.
 
     Parameters (SI units)
@@ -498,7 +815,31 @@ def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_targ
     ``h_pulloff`` (lift there), ``F_jump_out``/``h_jump_out`` (last contact state before the
     jump out of contact; NaN if contact is lost continuously), ``F_after_jump_out``,
     ``a_jump_out``, ``h_contact_lost``/``F_contact_lost`` (last contact sample), ``h_jump_in``, ``h_separation``, ``h_turn``, ``wall_time`` [s].
+
+    Force-controlled retraction
+    ---------------------------
+    force_rate : float     [N/s] (> 0). Given, ``v_out`` must be None: after the approach the
+                           force is prescribed, ``F(t) = -F_target + force_rate (t - t_turn)``
+                           (rigid indenter, no machine spring), and the lift is the extra unknown.
+    dF : float             force per retraction step [N] (nominal ``dt = dF/force_rate``; or give
+                           ``dt``). The approach step is ``dh/v_in`` (or ``dt_in``).
+    The retraction stops at the fold where no state carries the prescribed force any more (see
+    the module docstring). The result then has the arrays (``segment`` 1 = force-controlled,
+    the fold state is the last sample), ``jumps`` (of the approach), ``F_pulloff`` (prescribed
+    force at the fold time), ``t_pulloff`` (time since the start), ``h_pulloff``, ``a_pulloff``,
+    ``b_pulloff``, ``F_pulloff_state`` (the force of the fold state, = ``F_pulloff`` to
+    round-off), ``last_step`` [s], ``h_jump_in``, ``h_turn``, ``t_turn``, ``b_max``, ``x_max``,
+    ``n_steps``, ``wall_time``.
     """
+    if force_rate is not None:
+        if v_out is not None:
+            raise ValueError("give either v_out (displacement control) or force_rate")
+        return _force_path(G_inf=G_inf, arms=arms, sigma_c=sigma_c, delta=delta, R=R, h0=h0,
+                           v_in=v_in, F_target=F_target, force_rate=force_rate,
+                           n_elements=n_elements, dt=dt, dt_in=dt_in, dh=dh, dF=dF, x_max=x_max,
+                           max_steps=max_steps)
+    if v_out is None:
+        raise ValueError("v_out (or force_rate) is required")
     t_wall = _time.perf_counter()
     model = _Model(G_inf, arms, sigma_c, delta, R)
     if x_max is None:
@@ -524,5 +865,49 @@ def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_targ
     out.update(_summary(out, jumps))
     out["x_max"] = float(x_max)
     out["n_steps"] = int(len(out["F"]))
+    out["wall_time"] = _time.perf_counter() - t_wall
+    return out
+
+
+def _force_path(*, G_inf, arms, sigma_c, delta, R, h0, v_in, F_target, force_rate, n_elements,
+                dt, dt_in, dh, dF, x_max, max_steps):
+    """Displacement-controlled approach, then force-controlled retraction to the pull-off."""
+    t_wall = _time.perf_counter()
+    if not force_rate > 0.0:
+        raise ValueError("force_rate must be > 0")
+    if dh is not None:
+        dt_inn = dh / v_in
+    elif dt_in is not None:
+        dt_inn = float(dt_in)
+    else:
+        raise ValueError("force control: give dh or dt_in for the approach")
+    if dF is not None:
+        dtn = dF / force_rate
+    elif dt is not None:
+        dtn = float(dt)
+    else:
+        raise ValueError("force control: give dF (or dt) for the retraction")
+    model = _Model(G_inf, arms, sigma_c, delta, R)
+    if x_max is None:
+        # elastic approach with the relaxed modulus: the largest zone of the path is at the turn
+        x0 = _default_xmax(G_inf, sigma_c, delta, R, F_target)
+        pre = _Solver(_Model(G_inf, (), sigma_c, delta, R), np.linspace(0.0, x0, 65))
+        rec0, _ = _march(pre, h0, ((-v_in, delta / 5.0 / v_in),), delta, F_target, max_steps)
+        x_max = 1.5 * max(rec0["b"])
+    X = np.linspace(0.0, x_max, int(n_elements) + 1)
+    sol = _Solver(model, X)
+    rec, jumps = _march(sol, h0, ((-v_in, dt_inn),), delta, F_target, max_steps)
+    kappa = dtn / float(np.min(model.taui)) if len(model.taui) else math.inf
+    fold = _retract_force(sol, rec, F_target, force_rate, dtn, kappa, max_steps)
+    out = {k: np.array(vv) for k, vv in rec.items()}
+    out["jumps"] = jumps
+    ji = [j for j in jumps if j["segment"] == 0]
+    out.update(F_pulloff=float(fold["F"]), t_pulloff=float(fold["t"]), h_pulloff=float(fold["h"]),
+               a_pulloff=float(fold["a"]), b_pulloff=float(fold["b"]),
+               F_pulloff_state=float(fold["F_state"]), last_step=float(fold["last_step"]),
+               h_jump_in=float(ji[0]["before"]["h"]) if ji else float("nan"),
+               h_turn=float(out["h"][np.nonzero(out["segment"] == 1)[0][0] - 1]),
+               t_turn=float(fold["t_turn"]), b_max=float(np.max(out["b"])), x_max=float(x_max),
+               n_steps=int(len(out["F"])))
     out["wall_time"] = _time.perf_counter() - t_wall
     return out
