@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 from unittest import mock
 
+import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -165,6 +166,15 @@ def test_set_strings(overrides):
         status, err = _call(argv, out)
         if status is not None:
             _check_refused(status, err, "run", out)
+
+
+@pytest.mark.parametrize("key", ["0\x850", "a\u2028b", "loading.v\rx", "x\x1cy"])
+def test_a_key_with_a_line_break_is_refused_on_one_line(tmp_path, key):
+    """Found by the fuzz test above: a key holding a character ``str.splitlines`` breaks at
+    (NEL, here) split the refusal into two lines; it is now written as its escape."""
+    argv = ["run", SEED, "-o", tmp_path / "r.h5", "-q", "--no-plot", f"--set={key}=1"]
+    status, err = _call(argv, tmp_path)
+    _check_refused(status, err, "run", tmp_path)
 
 
 SPECS = st.one_of(

@@ -31,8 +31,19 @@ class SceneError(ValueError):
     """Any problem with a scene; ``problems`` holds one line per problem."""
 
     def __init__(self, problems: str | Sequence[str]):
-        self.problems = [problems] if isinstance(problems, str) else list(problems)
+        problems = [problems] if isinstance(problems, str) else list(problems)
+        self.problems = [_one_line(p) for p in problems]
         super().__init__("\n".join(self.problems))
+
+
+#: What ``str.splitlines`` breaks a line at: in a problem (a key typed with a stray control
+#: character) each is written as its escape, so a problem stays one line.
+_LINE_BREAKS = frozenset("\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029")
+
+
+def _one_line(text: str) -> str:
+    return "".join(c.encode("unicode_escape").decode("ascii") if c in _LINE_BREAKS else c
+                   for c in text)
 
 
 class _Section(BaseModel):
