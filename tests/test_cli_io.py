@@ -87,7 +87,8 @@ SLOW_CONFIGS = {"prony_external.yaml": ["--set", "model.until=detach"],
                 "sphere_force_control.yaml": ["--set", "numerics.rtol=1e-2"]}
 #: Configs run in full by their own tests (here they would only repeat them).
 RUN_ELSEWHERE = {"sphere_force_control.yaml": "tests/test_paths.py",
-                 "cone_elastic.yaml": "tests/test_paths.py"}
+                 "cone_elastic.yaml": "tests/test_paths.py",
+                 "compliant_machine.yaml": "tests/test_propagation.py"}
 DATA = Path(__file__).resolve().parent / "data"
 #: Every shipped config's numbers before the solvers were rebuilt (issue 9), and the
 #: independent moving-edge reference (pulloff.references.edge).
