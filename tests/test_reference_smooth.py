@@ -19,6 +19,21 @@ REFERENCE = json.loads((Path(__file__).parent / "data" / "smooth_reference.json"
 SCENE = REFERENCE["scene"]
 
 
+def sls_sphere_scene(ref_scene, control, retract):
+    """The reference's standard linear solid under its sphere (SI values of ``ref_scene``):
+    the approach to ``F_target``, then ``retract`` under ``control``."""
+    s = ref_scene
+    return parse_scene({
+        "schema": 1, "name": "sls_sphere",
+        "geometry": {"kind": "sphere", "radius": s["R"]},
+        "material": {"kind": "standard_linear_solid", "G_inf": s["G_inf"],
+                     "G_1": s["arms"][0][0], "tau_1": s["arms"][0][1]},
+        "adhesion": {"kind": "dugdale", "sigma_c": s["sigma_c"], "delta": s["delta"]},
+        "loading": {"kind": "path", "control": control, "h0": s["h0"], "segments": [
+            {"speed": -s["v_in"], "until": {"force": -s["F_target"]}}, retract]},
+        "numerics": {"rtol": 1e-3}})
+
+
 def test_reference_solver_gives_maugis_dugdale_on_an_elastic_sphere():
     """Elastic: the history term vanishes, so only the sampling of the force maximum matters
     (measured 1e-9 at N = 100, dh = 4 nm; jump out 1e-7)."""
@@ -38,16 +53,8 @@ def test_sls_sphere_matches_the_independent_reference():
     at 1 um/s: the pull-off is 2.9x the elastic one. Levels n = 32 and 64 of the contact
     stepper (measured 2.7e-2 and 2.6e-3 off the reference in F_pulloff; 3.3e-3 and 3.4e-4 in
     the jump-out lift); the full solver at rtol 1e-3 (56 s, not here) is 5e-6 off."""
-    scene = parse_scene({
-        "schema": 1, "name": "sls_sphere",
-        "geometry": {"kind": "sphere", "radius": SCENE["R"]},
-        "material": {"kind": "standard_linear_solid", "G_inf": SCENE["G_inf"],
-                     "G_1": SCENE["arms"][0][0], "tau_1": SCENE["arms"][0][1]},
-        "adhesion": {"kind": "dugdale", "sigma_c": SCENE["sigma_c"], "delta": SCENE["delta"]},
-        "loading": {"kind": "path", "h0": SCENE["h0"], "segments": [
-            {"speed": -SCENE["v_in"], "until": {"force": -SCENE["F_target"]}},
-            {"speed": SCENE["v_out"], "until": "separation"}]},
-        "numerics": {"rtol": 1e-3}})
+    scene = sls_sphere_scene(SCENE, "displacement",
+                             {"speed": SCENE["v_out"], "until": "separation"})
     setup = contact_setup.setup(scene)
     errors = []
     for n in (32, 64):
@@ -83,16 +90,7 @@ def test_force_controlled_sls_sphere_matches_the_independent_reference():
     in F_pulloff, 4.2e-4 in h_pulloff, 4.4e-3 in t_pulloff; n = 32: 4.3e-2; n = 128: 2.6e-4)."""
     ref = FORCE_REFERENCE
     s = ref["scene"]
-    scene = parse_scene({
-        "schema": 1, "name": "sls_sphere_force",
-        "geometry": {"kind": "sphere", "radius": s["R"]},
-        "material": {"kind": "standard_linear_solid", "G_inf": s["G_inf"],
-                     "G_1": s["arms"][0][0], "tau_1": s["arms"][0][1]},
-        "adhesion": {"kind": "dugdale", "sigma_c": s["sigma_c"], "delta": s["delta"]},
-        "loading": {"kind": "path", "control": "force", "h0": s["h0"], "segments": [
-            {"speed": -s["v_in"], "until": {"force": -s["F_target"]}},
-            {"force_rate": s["force_rate"], "until": "separation"}]},
-        "numerics": {"rtol": 1e-3}})
+    scene = sls_sphere_scene(s, "force", {"force_rate": s["force_rate"], "until": "separation"})
     setup = contact_setup.setup(scene)
     stepper = Stepper(setup, 64, contact._time_scale(scene, setup))
     stepper.run(1e9)

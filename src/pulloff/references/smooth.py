@@ -869,24 +869,24 @@ def sphere_path_reference(*, G_inf, arms=(), sigma_c, delta, R, h0, v_in, F_targ
     return out
 
 
+def _step_length(increment, rate, dt, missing):
+    """A time step [s]: ``increment / rate`` (a lift or force increment at its rate), else
+    ``dt``."""
+    if increment is not None:
+        return increment / rate
+    if dt is not None:
+        return float(dt)
+    raise ValueError(f"force control: {missing}")
+
+
 def _force_path(*, G_inf, arms, sigma_c, delta, R, h0, v_in, F_target, force_rate, n_elements,
                 dt, dt_in, dh, dF, x_max, max_steps):
     """Displacement-controlled approach, then force-controlled retraction to the pull-off."""
     t_wall = _time.perf_counter()
     if not force_rate > 0.0:
         raise ValueError("force_rate must be > 0")
-    if dh is not None:
-        dt_inn = dh / v_in
-    elif dt_in is not None:
-        dt_inn = float(dt_in)
-    else:
-        raise ValueError("force control: give dh or dt_in for the approach")
-    if dF is not None:
-        dtn = dF / force_rate
-    elif dt is not None:
-        dtn = float(dt)
-    else:
-        raise ValueError("force control: give dF (or dt) for the retraction")
+    dt_inn = _step_length(dh, v_in, dt_in, "give dh or dt_in for the approach")
+    dtn = _step_length(dF, force_rate, dt, "give dF (or dt) for the retraction")
     model = _Model(G_inf, arms, sigma_c, delta, R)
     if x_max is None:
         # elastic approach with the relaxed modulus: the largest zone of the path is at the turn

@@ -115,7 +115,7 @@ def _nested(stepper, step, H_guess, force_residual, H_travel):
     probe = max(1e-3 * H_travel, 1e-12 * max(abs(H_guess), 1.0))
     # A jump behind a soft spring moves the indenter too (by F/k): its lift is searched as
     # widely as the jump's edge.
-    H = phases._root(residual, H_guess, r0, H_guess + min(probe, 1e-9 * max(abs(H_guess), 1.0)),
+    H = phases.root(residual, H_guess, r0, H_guess + min(probe, 1e-9 * max(abs(H_guess), 1.0)),
                      -math.inf, math.inf, step.jump)
     if H is None:
         raise phases.Lost("balance")

@@ -145,7 +145,7 @@ def _residual(stepper, x, d):
         return _evaluate(stepper, step, x, H).gap - 1.0
 
     rate = now.Hdot if math.isfinite(now.Hdot) else 0.0
-    H = phases._root(gap_left, now.H, gap_left(now.H), now.H + rate * d, -math.inf, math.inf)
+    H = phases.root(gap_left, now.H, gap_left(now.H), now.H + rate * d, -math.inf, math.inf)
     if H is None:
         return math.nan, step, None
     ev = _evaluate(stepper, step, x, H)

@@ -88,7 +88,7 @@ def _bracketed(f, a, fa, b, fb):
     return b
 
 
-def _root(f, x_held, f_held, x_guess, lo, hi, wide=False):
+def root(f, x_held, f_held, x_guess, lo, hi, wide=False):
     """The root of ``f`` nearest ``x_held`` inside ``[lo, hi]`` (the branch the solution is
     on): brackets grow from ``x_held`` geometrically, the side of ``x_guess`` first, until
     ``f`` changes sign; None if it does not within a reach of a quarter of ``x_held`` (or of
@@ -165,7 +165,7 @@ def receding(step, H, guess_alpha):
         return step.evaluate(alpha, edge_zone(step, H, alpha), H).gap - 1.0
 
     r_held = residual(now.alpha)
-    alpha = _root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha,
+    alpha = root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha,
                   step.jump)
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
@@ -191,7 +191,7 @@ def zone_end(step, H, alpha, guess_beta, top=math.inf, wide=False):
         return step.evaluate(alpha, beta, H).gap - 1.0
 
     start = min(max(now.beta, alpha * (1.0 + 1e-12), 1e-12), top)
-    beta = _root(residual, start, residual(start), min(max(guess_beta, alpha), top), alpha, top,
+    beta = root(residual, start, residual(start), min(max(guess_beta, alpha), top), alpha, top,
                  step.jump or wide)
     if beta is None:
         raise Lost("zone")
@@ -227,7 +227,7 @@ def smooth_contact(step, H, guess_alpha):
         return step.evaluate(alpha, edge_zone(step, H, alpha), H).gap - 1.0
 
     start = max(now.alpha, 1e-12)
-    alpha = _root(residual, start, residual(start), max(guess_alpha, 1e-12), 0.0, math.inf,
+    alpha = root(residual, start, residual(start), max(guess_alpha, 1e-12), 0.0, math.inf,
                   step.jump)
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
