@@ -244,6 +244,12 @@ _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
 
 
+#: Below this many relaxation times per step the youngest interval holds no layer: ``R`` is
+#: entire with Taylor terms ``(k dt/c)^n / n!``, and Gauss-Legendre's 8 points (exact to degree
+#: 15) leave less than ``0.5^16/16!`` ~ 1e-18 of it.
+_SMOOTH_FIRST_INTERVAL = 0.5
+
+
 @njit(cache=True)
 def age_interval_weights(k, c, dt, n_ages, nodes, complements, weights):
     """Product-integration weights of ``U/q`` between element ages ``m dt`` and ``(m+1) dt``.
@@ -263,7 +269,7 @@ def age_interval_weights(k, c, dt, n_ages, nodes, complements, weights):
     for m in range(n_ages):
         acc_y = 0.0
         acc_o = 0.0
-        if m == 0:
+        if m == 0 and k * dt > _SMOOTH_FIRST_INTERVAL * c:
             # The layer sits inside the youngest interval: tanh-sinh clusters at age 0.
             for i in range(nodes.shape[0]):
                 r = onset_ratio(nodes[i] * dt, k, c)

@@ -28,7 +28,6 @@ import math
 from fractions import Fraction
 
 import numpy as np
-from scipy.optimize import brentq
 
 __all__ = [
     "ALPHA_SWITCH",
@@ -68,8 +67,6 @@ TAYLOR_COEFFS = (
 )
 
 _EPS = np.finfo(float).eps
-_BRENT_RTOL = 4.0 * _EPS  # the smallest rtol scipy's brentq accepts
-_BRENT_XTOL = 1e-300  # roots may be tiny (t* ~ 2 alpha); let rtol decide
 
 
 def _out(x):
@@ -100,7 +97,7 @@ _F_SERIES = [float(c) for c in _series_coeffs_f(26)]
 _F_SERIES_MAX_T = 1.0
 
 # Inverse series of eq. 53 about alpha = 0: t* = alpha * (2 - 2 alpha + 16/3 alpha^2 - ...).
-# Used where the brentq bracket would be narrower than the float spacing.
+# Used where the root bracket would be narrower than the float spacing.
 _T_OVER_ALPHA_SERIES = (2.0, -2.0, 16.0 / 3.0, -20.0, 408.0 / 5.0, -352.0, 100096.0 / 63.0)
 _ALPHA_SERIES_MAX = 1e-4  # next term ~ 8e3 alpha^7: < 1e-21 relative below this
 _ALPHA_FIXED_POINT_MIN = 100.0  # t* > 14: e^{-t*} < 1e-6, the large-alpha iteration contracts
@@ -111,6 +108,39 @@ def _horner(coeffs, x):
     for c in coeffs[-2::-1]:
         acc = acc * x + c
     return acc
+
+
+def _horner_scalar(coeffs, x: float) -> float:
+    acc = coeffs[-1]
+    for c in coeffs[-2::-1]:
+        acc = acc * x + c
+    return acc
+
+
+def bracketed_newton(f, fprime, lo: float, hi: float, x: float) -> float:
+    """Root of an increasing ``f`` with ``f(lo) <= 0 <= f(hi)``, from ``x`` in the bracket.
+
+    Newton's step where it stays inside the bracket, bisection where it does not; the bracket
+    shrinks with every evaluation. Stops at a step below four ulp, in ~5 evaluations for the
+    smooth convex functions here (scipy's brentq took 10-12, and its call overhead dominated
+    the closed forms beside a run).
+    """
+    for _ in range(200):
+        fx = f(x)
+        if fx == 0.0:
+            return x
+        if fx < 0.0:
+            lo = x
+        else:
+            hi = x
+        d = fprime(x)
+        x_new = x - fx / d if d > 0.0 else math.nan
+        if not lo < x_new < hi:
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= 4.0 * _EPS * abs(x_new) or not lo < x_new < hi:
+            return x_new
+        x = x_new
+    return x
 
 
 # ---------------------------------------------------------------------------------------------
@@ -189,6 +219,13 @@ def seed_rhs(t_star):
     return _out(out)
 
 
+def _seed_rhs_scalar(t: float) -> float:
+    """:func:`seed_rhs` for one finite ``t >= 0`` (math, no arrays)."""
+    if t < _F_SERIES_MAX_T:
+        return _horner_scalar(_F_SERIES, t)
+    return 0.5 * (t + 1.0) * (2.0 * t + (t + 1.0) * math.expm1(-t))
+
+
 def _seed_rhs_prime(t):
     # eq. 67; both terms positive for t <= 1 and t dominates beyond, so no cancellation
     return t + 0.5 * (1.0 - t * t) * math.exp(-t)
@@ -229,7 +266,7 @@ def _t_star_scalar(al):
     if al > _ALPHA_FIXED_POINT_MIN:
         # eq. 53 rearranged: t*^2 = 2 alpha + 1 - (t*+1)^2 e^{-t*}; for t* > 14 the map's slope is
         # ~ t* e^{-t*}/2 < 1e-5, so the iteration from eq. 59 converges to machine precision in a
-        # few steps.  brentq would fail here once e^{-t*} falls below the float spacing, because
+        # few steps.  A bracketed search would fail here once e^{-t*} falls below the float spacing, because
         # eq. 59 then brackets the root only up to rounding.
         t = math.sqrt(2.0 * al + 1.0)
         for _ in range(20):
@@ -247,19 +284,15 @@ def _t_star_scalar(al):
     hi = min(2.0 * al, math.sqrt(2.0 * al + 1.0))
 
     def res(t):
-        return seed_rhs(t) - al
+        return _seed_rhs_scalar(t) - al
 
     # guard against rounding at the bracket ends (never triggered in tests, cheap insurance)
     while res(lo) > 0:
         lo *= 0.5
     while res(hi) < 0:
         hi *= 2.0
-    t = brentq(res, lo, hi, xtol=_BRENT_XTOL, rtol=_BRENT_RTOL, maxiter=200)
-    # one Newton step: brentq stops within a few ulp, Newton brings it to rounding level
-    t_new = t - res(t) / _seed_rhs_prime(t)
-    if lo <= t_new <= hi:
-        t = t_new
-    return t
+    # f is convex: Newton from the upper end approaches the root from above, never leaving.
+    return bracketed_newton(res, _seed_rhs_prime, lo, hi, hi)
 
 
 def _t_over_alpha_series(al):
@@ -271,8 +304,8 @@ def seed_t_star(alpha):
 
     ``alpha = 0 -> 0``, ``alpha = inf -> inf``; ``ValueError`` for negative or NaN ``alpha``.
     Relative accuracy ~1e-15: an inverse series below ``alpha = 1e-4``
-    (``t* = 2 alpha - 2 alpha^2 + 16/3 alpha^3 - ...``), brentq with a rigorous bracket between
-    the small- and large-alpha bounds up to ``alpha = 100``, and a contracting fixed-point
+    (``t* = 2 alpha - 2 alpha^2 + 16/3 alpha^3 - ...``), Newton inside a rigorous bracket
+    between the small- and large-alpha bounds up to ``alpha = 100``, and a contracting fixed-point
     iteration on eq. 53 rearranged as ``t*^2 = 2 alpha + 1 - (t*+1)^2 exp(-t*)`` above.
     Accepts arrays (element by element).
     """
@@ -454,6 +487,11 @@ def _g_gap(S):
     return S * math.atan(S) - S * S / (1.0 + math.sqrt(1.0 + S * S))
 
 
+def _g_gap_prime(S):
+    """``g'(S) = atan(S) + S / (1 + S^2) - S / sqrt(1 + S^2)`` (only steers Newton)."""
+    return math.atan(S) + S / (1.0 + S * S) - S / math.sqrt(1.0 + S * S)
+
+
 def elastic_mdr_dugdale(G, sigma_c, delta, a):
     """Exact elastic (``eta = 0``) MDR-Dugdale flat punch at the onset of detachment.
 
@@ -487,7 +525,7 @@ def elastic_mdr_dugdale(G, sigma_c, delta, a):
         hi = 2.0 * lo
         while _g_gap(hi) < c:
             hi *= 2.0
-        S = brentq(lambda s: _g_gap(s) - c, lo, hi, xtol=_BRENT_XTOL, rtol=_BRENT_RTOL, maxiter=200)
+        S = bracketed_newton(lambda s: _g_gap(s) - c, _g_gap_prime, lo, hi, lo)
     h = sigma_c * a * S / (2.0 * G)
     b = a * math.sqrt(1.0 + S * S)
     F_contact = 8.0 * a * G * h
@@ -529,8 +567,9 @@ def elastic_internal_onset(G, sigma_c, delta, R):
         hi = min(0.5 * math.pi, 2.0 * math.sqrt(2.0 * chi_R))
         while g(hi) < chi_R and hi < 0.5 * math.pi:
             hi = min(0.5 * math.pi, 2.0 * hi)
-        theta = brentq(lambda x: g(x) - chi_R, 0.0, hi, xtol=_BRENT_XTOL, rtol=_BRENT_RTOL,
-                       maxiter=200)
+        # g' = theta cos(theta) > 0 below pi/2
+        theta = bracketed_newton(lambda x: g(x) - chi_R, lambda x: x * math.cos(x), 0.0, hi,
+                                  min(hi, math.sqrt(2.0 * chi_R)))
     a = R * math.cos(theta) if not strength_limited else 0.0
     h = sigma_c * R * math.sin(theta) / (2.0 * G)
     F_contact = 4.0 * sigma_c * R * R * math.cos(theta) * math.sin(theta) if a > 0 else 0.0
@@ -559,6 +598,19 @@ def _cohesive_bracket(S):
     return np.where(small, series, direct)
 
 
+def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
+    """:func:`cohesive_force` for one ``b`` (math, no arrays: it is on a run's hot path)."""
+    if not b >= a:
+        raise ValueError("cohesive_force needs b >= a")
+    S = math.sqrt((b - a) * (b + a)) / a
+    if S < _COH_SERIES_MAX_S:
+        s2 = S * S
+        bracket = S * s2 * _horner_scalar(_COH_SERIES, s2)
+    else:
+        bracket = (1.0 + S * S) * math.atan(S) - S
+    return 2.0 * sigma_c * a * a * bracket
+
+
 def cohesive_force(sigma_c, a, b):
     """Force of the cohesive annulus ``a < r < b`` alone, in [N] (MODEL.md section 3).
 
@@ -567,8 +619,10 @@ def cohesive_force(sigma_c, a, b):
     array).  For small ``S`` the force is ``~ (4/3) sigma_c a^2 S^3`` and both forms cancel
     catastrophically, so a series is used below ``S = 0.5``; accurate to ~1e-15 relative.
     """
-    b = np.asarray(b, dtype=float)
     a = float(a)
+    if np.ndim(b) == 0:
+        return _cohesive_force_scalar(float(sigma_c), a, float(b))
+    b = np.asarray(b, dtype=float)
     if np.any(b < a):
         raise ValueError("cohesive_force needs b >= a")
     # (b - a) is exact for b <= 2a (Sterbenz), so S keeps full relative precision for thin zones

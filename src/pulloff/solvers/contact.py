@@ -101,7 +101,7 @@ class ContactSolver(Solver):
         result = ladder.refine(
             level, _controlled, scene.numerics.rtol, _FIRST_N, ORDER,
             can_refine=lambda run, n: 2 * len(run.rows) <= MAX_STEPS,
-            interrupted=lambda run: getattr(run, "interrupted", False), extrapolated=True,
+            interrupted=lambda run: getattr(run, "interrupted", False), extrapolated="measured",
             floor=_floor)
         return _result(scene, setup, result, observers, time.perf_counter() - wall)
 

@@ -1,0 +1,78 @@
+"""The accuracy ladder's extrapolation and its estimate (pulloff.solvers.levels)."""
+
+import math
+
+import numpy as np
+from hypothesis import given, settings, strategies as st
+
+from pulloff.solvers import levels
+
+ORDER = levels.Order(1.0, 2.0)
+
+
+def ladder(coefficients, h_finest, n_levels):
+    """Outputs ``1 + sum c_q h^q`` (one output) of ``n_levels`` levels, step ratio 2, finest
+    last."""
+    hs = h_finest * 2.0 ** np.arange(n_levels - 1, -1, -1)
+    return [np.array([1.0 + sum(c * h**q for q, c in coefficients.items())]) for h in hs]
+
+
+def test_a_single_output_of_the_method_order_gets_a_nonzero_estimate():
+    """With the order measured from the same three levels, the two extrapolations agree by
+    construction and the estimate is zero; the method's order keeps the h^3 term visible."""
+    values = ladder({2: 1.0, 3: -10.0}, 1e-2, 3)
+    e, estimate = levels.extrapolate(values, ORDER)
+    true = abs(e[0] - 1.0)
+    _, degenerate = levels.extrapolate_measured(values, ORDER)
+    assert degenerate < 1e-3 * true  # the weakness the contact solver still has
+    assert true <= estimate <= 10.0 * true
+
+
+def test_three_levels_can_hide_the_error_so_the_ladder_waits_for_four():
+    """``b h^3 + c h^4`` with the two cancelling in the change of the extrapolations (the
+    case hypothesis found): three levels' estimate is below the error, four levels' is not,
+    and the ladder does not stop at three."""
+    values = ladder({3: -6.0, 4: 65.0}, 10.0**-1.875, 4)
+    e3, estimate3 = levels.extrapolate(values[1:], ORDER)
+    e4, estimate4 = levels.extrapolate(values, ORDER)
+    assert estimate3 < abs(e3[0] - 1.0) and estimate4 >= abs(e4[0] - 1.0)
+    ran = []
+    levels.refine(lambda n: ran.append(n) or n, lambda n: ladder({3: -6.0, 4: 65.0}, 1.0 / n, 1)[0],
+                  1.0, 8, ORDER, can_refine=lambda r, n: n <= 1024, extrapolated="method")
+    assert ran == [8, 16, 32, 64]
+
+
+def test_extrapolation_removes_the_second_order_term_exactly():
+    values = ladder({2: 3.0}, 1e-2, 4)
+    e, estimate = levels.extrapolate(values, ORDER)
+    assert abs(e[0] - 1.0) < 1e-15 and estimate < 1e-14
+
+
+def test_a_sudden_drop_between_extrapolations_does_not_shrink_the_estimate():
+    """Extrapolations 2.1e-6, 2.8e-8, 3.0e-8 off (measured on a viscous seed scene): the last
+    change is 1000x below the one before, by cancellation, not convergence."""
+    e_true = [2.1e-6, 2.8e-8, 3.0e-8]
+    # Levels whose pairwise extrapolations (order 2) are exactly these.
+    v = [np.array([1.0 + 1e-4])]
+    for err in e_true:
+        # e = v_new + (v_new - v_old)/3  ->  v_new = (3 e + v_old) / 4
+        v.append(np.array([(3.0 * (1.0 + err) + v[-1][0]) / 4.0]))
+    e, estimate = levels.extrapolate(v, ORDER)
+    assert e[0] - 1.0 == np.float64(3.0e-8) or abs(e[0] - 1.0 - 3.0e-8) < 1e-14
+    assert estimate >= 3.0e-8
+
+
+@settings(max_examples=200, deadline=None)
+@given(a=st.floats(-10, 10), b=st.floats(-10, 10).filter(lambda x: abs(x) > 1e-3),
+       c=st.floats(-100, 100), log_h=st.floats(-4, -1.5))
+def test_property_the_estimate_is_never_below_the_error(a, b, c, log_h):
+    """Any error expansion ``a h^2 + b h^3 + c h^4`` on four levels where it converges: the
+    estimate of the extrapolated value is at least its true error (to rounding)."""
+    values = ladder({2: a, 3: b, 4: c}, 10.0**log_h, 4)
+    _, measured = levels.richardson(values[-3:], ORDER)
+    e, estimate = levels.extrapolate(values, ORDER)
+    if not math.isfinite(measured) or measured < levels.DIVERGING_ORDER:
+        assert estimate == math.inf or estimate == 0.0
+        return
+    true = abs(e[0] - 1.0)
+    assert estimate >= true - 1e-14, (estimate, true)
