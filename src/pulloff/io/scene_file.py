@@ -10,6 +10,7 @@ string. A scene is valid when its schema accepts it *and* a solver honours every
 from __future__ import annotations
 
 import copy
+import functools
 import math
 import re
 from collections.abc import Mapping, Sequence
@@ -80,7 +81,16 @@ _SceneDumper.add_implicit_resolver(_TAGS["float"], _CORE_12["float"], list(_FIRS
 
 
 def read_yaml(text: str, where: str = "scene"):
-    """YAML 1.2 text -> plain data; a syntax error is a :class:`SceneError` naming the line."""
+    """YAML 1.2 text -> plain data; a syntax error is a :class:`SceneError` naming the line.
+
+    The same text is parsed once per process (a sweep reads its base scene and each axis
+    value for every point, and parsing was half of a sweep's time); each call gets its own
+    copy."""
+    return copy.deepcopy(_parsed_yaml(text, where))
+
+
+@functools.lru_cache(maxsize=256)
+def _parsed_yaml(text: str, where: str):
     try:
         return yaml.load(text, Loader=SceneLoader)
     except yaml.YAMLError as e:

@@ -101,15 +101,16 @@ def extrapolate(values: Sequence[np.ndarray], order: Order,
       measured 47x below the error on a viscous scene); below the diverging order the larger
       of their last two changes.
 
-    Below the diverging order of the levels themselves no extrapolation is made (the finest
-    values and an infinite estimate).
+    Below the diverging order of the levels themselves no extrapolation is made: the finest
+    values, with :func:`richardson`'s estimate (the larger of the last two changes; rounding
+    alone on a scene the levels solve exactly).
     """
     v = [np.asarray(x, dtype=float) for x in values[-4:]]
-    _, measured = richardson(v[-3:], order, floor)
+    raw_estimate, measured = richardson(v[-3:], order, floor)
     if not math.isfinite(measured) or measured < DIVERGING_ORDER:
-        # No measured order (outputs unchanged between levels) or no convergence.
-        same = np.array_equal(v[-2], v[-1], equal_nan=True)
-        return v[-1].copy(), (0.0 if same else math.inf)
+        # Outputs unchanged, levels not converging, or (an exact scene) differing by rounding
+        # alone: the finest level, with the larger of its last two changes as the estimate.
+        return v[-1].copy(), raw_estimate
     f = 1.0 / (2.0 ** order.high - 1.0)
     e = [fine + (fine - coarse) * f for coarse, fine in zip(v[:-1], v[1:])]
     scale = _scale(e[-1], floor)
