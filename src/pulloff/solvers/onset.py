@@ -73,18 +73,19 @@ def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
     that jumps with where in the step the crossing falls) would otherwise make irregular.
     Newton from the linear guess, kept inside the step.
     """
-    t1, t2 = t[n - 1], t[n]
-    g1, g2 = gap[n - 1], gap[n]
-    t_lin = t1 + (1.0 - g1) * (t2 - t1) / (g2 - g1)
     first = max(0, n - 3)
-    if n - first < 2:
+    t_pts = [float(x) for x in t[first:n + 1]]
+    coef = [float(x) for x in gap[first:n + 1]]
+    t1, t2, g1, g2 = t_pts[-2], t_pts[-1], coef[-2], coef[-1]
+    t_lin = t1 + (1.0 - g1) * (t2 - t1) / (g2 - g1)
+    m = len(t_pts)
+    if m < 3:
         return t_lin
     # Newton's divided differences through the points first..n, centred on the step.
-    ts = np.asarray(t[first:n + 1], dtype=float) - t2
-    coef = np.asarray(gap[first:n + 1], dtype=float).copy()
-    m = ts.size
+    ts = [x - t2 for x in t_pts]
     for j in range(1, m):
-        coef[j:] = (coef[j:] - coef[j - 1:-1]) / (ts[j:] - ts[:m - j])
+        for i in range(m - 1, j - 1, -1):
+            coef[i] = (coef[i] - coef[i - 1]) / (ts[i] - ts[i - j])
     x = t_lin - t2
     for _ in range(30):
         value, slope = coef[-1], 0.0
@@ -109,12 +110,8 @@ def preloaded_mesh(s0: float, n: int):
     of an element is weakest and varies fastest. The offsets ``s0 - sigma`` are exact, so the
     kernels never subtract two nearly equal ``s`` and ``sigma``. No nodes when ``s0 = 0``.
     """
-    if s0 <= 0.0:
-        return np.zeros(0), np.zeros(0)
-    angles = np.arange(n, 0, -1) * (0.5 * np.pi / n)
-    sigma = s0 * np.cos(angles)
-    sigma[0] = 0.0
-    return sigma, 2.0 * s0 * np.sin(0.5 * angles) ** 2
+    sigma, offset, _, _ = kernels.preloaded_state(float(s0), int(n), 1.0, 1.0)
+    return sigma, offset
 
 
 #: Ages with tabulated weights, so the tables stay small however long the run. Older elements
@@ -140,7 +137,11 @@ def step_weights(k: float, c: float, dt: float, n_ages: int):
     rule = (kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
     if k > 0.0:
         w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_tab, *rule)
-        scale, m_old, m_new = kernels.onset_moments(k, c, dt, *rule)
+        if n_tab >= n_ages:  # the tables reach every age: the expansion is never used
+            scale, m_old, m_new = 0.0, np.zeros(kernels.BINOM_HALF.size), np.zeros(
+                kernels.BINOM_HALF.size)
+        else:
+            scale, m_old, m_new = kernels.onset_moments(k, c, dt, *rule)
         ratio, w_young, w_old = kernels.age_interval_weights(
             k, c, dt, n_tab, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
             kernels.TS_FINE_WEIGHTS)
@@ -306,18 +307,9 @@ def _preloaded(problem: Problem, dt: float, n_stop: int, n_preloaded, max_elemen
     n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
     if max_elements is not None:
         n_pre = min(n_pre, max(8, int(max_elements) // 4))
-    sig_pre, offset_pre = preloaded_mesh(s0, n_pre)
-    if c == 0.0:
-        # An elastic element follows its load at once, also the step lift h0 at t = 0.
-        U_pre = np.sqrt(offset_pre * (s0 + sig_pre)) / k
-    else:
-        U_pre = np.zeros_like(sig_pre)  # a damper cannot move instantly (MODEL.md: u(x,0) = 0)
-    nodes_pre = np.append(sig_pre, s0)
-    x_pre = np.sqrt(1.0 + nodes_pre * nodes_pre)
-    # kernels.interval_width, vectorised: x widths without cancellation for thin zones.
-    dx_pre = np.zeros(nodes_pre.size)
-    dx_pre[1:] = (np.diff(nodes_pre) * (nodes_pre[1:] + nodes_pre[:-1])
-                  / (x_pre[1:] + x_pre[:-1]))
+    # An elastic element follows its load at once, also the step lift h0 at t = 0; a damper
+    # cannot move instantly (MODEL.md: u(x,0) = 0).
+    sig_pre, offset_pre, U_pre, dx_pre = kernels.preloaded_state(float(s0), n_pre, k, c)
     # With a budget the preloaded mesh stops refining with the step: the cubic on v keeps
     # its error far below the trapezoid's (fourth order in its spacing).
     pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
