@@ -2,7 +2,8 @@
 
     python benchmarks/shipped_configs.py [--repeat 7]
 
-For each config under configs/: the first call's time (numba compile or cache load included,
+For each flat-punch pull under configs/ (smooth indenters and loading paths are in
+moving_edge_and_paths.py): the first call's time (numba compile or cache load included,
 reported on its own), the median and spread of repeated warm runs of ``simulate``, the
 achieved relative error against the independent quadrature reference (``pulloff.references.onset``)
 and the solver's own error estimate. Single-threaded; numba's threading is not used.
@@ -34,6 +35,8 @@ def main() -> None:
     print(header)
     for path in sorted(CONFIGS.glob("*.yaml")):
         scene = load_scene(path)
+        if scene.geometry.kind != "flat_punch" or scene.loading.kind != "constant_velocity":
+            continue  # smooth indenters and paths: benchmarks/moving_edge_and_paths.py
         times = []
         for _ in range(args.repeat):
             start = time.perf_counter()
