@@ -202,15 +202,16 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
     (optional) gives each output the size below which its error is judged absolutely
     (:func:`_scale`).
     """
-    levels = []
+    levels, outs = [], []
     n = n_first
     estimate, measured, values = math.nan, math.nan, None
     while True:
         levels.append(run(n))
         if interrupted(levels[-1]):
             return Ladder(levels, math.nan, math.nan)
+        outs.append(outputs(levels[-1]))
         if len(levels) >= 3:
-            last = [outputs(r) for r in levels[-4 if extrapolated else -3:]]
+            last = outs[-4 if extrapolated else -3:]
             lowest = None if floor is None else floor(levels[-1])
             estimate, measured = richardson(last[-3:], order, lowest)
             if extrapolated:
@@ -220,7 +221,6 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
         if not can_refine(levels[-1], 2 * n):
             if len(levels) == 2:
                 lowest = None if floor is None else floor(levels[-1])
-                estimate = relative_spread(outputs(levels[0]), outputs(levels[1]),
-                                           lowest) / 3.0
+                estimate = relative_spread(outs[0], outs[1], lowest) / 3.0
             return Ladder(levels, estimate, measured, values)
         n *= 2
