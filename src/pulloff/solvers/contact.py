@@ -85,18 +85,10 @@ class ContactSolver(Solver):
     def solve(self, scene, observers) -> Result:
         wall = time.perf_counter()
         setup = make_setup(scene)
-        t_scale = _time_scale(scene, setup)
-        t_end = setup.t_max if math.isfinite(setup.t_max) else DEFAULT_SPAN * t_scale
 
         def level(n):
-            stepper = Stepper(setup, n, t_scale)
             with observers.progress(f"n = {n}", None) as update:
-                try:
-                    stepper.run(t_end, update)
-                except KeyboardInterrupt:
-                    stepper.interrupted = True
-            stepper.summary = summarise(stepper)
-            return stepper
+                return run_level(scene, n, setup, update)
 
         result = ladder.refine(
             level, _controlled, scene.numerics.rtol, _FIRST_N, ORDER,
@@ -104,6 +96,23 @@ class ContactSolver(Solver):
             interrupted=lambda run: getattr(run, "interrupted", False), extrapolated="measured",
             floor=_floor)
         return _result(scene, setup, result, observers, time.perf_counter() - wall)
+
+
+def run_level(scene, n: int, setup=None, progress=None) -> Stepper:
+    """One level of the ladder at resolution ``n`` (about ``n`` steps per time scale, every
+    step halved from ``n`` to ``2 n``), run to the loading's end; its SI summary is
+    ``.summary``. What :meth:`ContactSolver.solve` extrapolates, and what the separation
+    work-precision benchmark times at fixed ``n``."""
+    setup = setup or make_setup(scene)
+    t_scale = _time_scale(scene, setup)
+    t_end = setup.t_max if math.isfinite(setup.t_max) else DEFAULT_SPAN * t_scale
+    stepper = Stepper(setup, n, t_scale)
+    try:
+        stepper.run(t_end, progress)
+    except KeyboardInterrupt:
+        stepper.interrupted = True
+    stepper.summary = summarise(stepper)
+    return stepper
 
 
 #: Outputs smaller than this share of their run's scale are judged against that share.
