@@ -102,3 +102,14 @@ def test_property_with_a_fifth_order_term_the_estimate_stays_within_ten_times(a,
     e, estimate = levels.extrapolate(values, ORDER)
     true = abs(e[0] - 1.0)
     assert estimate >= true / 10.0 - 1e-14, (estimate, true)
+
+
+def test_an_event_missing_on_a_coarse_level_is_not_converged():
+    """A level that ran out of time (t_max just past the event) has nan where the others
+    detach: the estimate is infinite, not 0 from an empty comparison (the review found the
+    onset solver stopping with estimate 0 and an error 8x rtol)."""
+    nan = math.nan
+    values = [np.array([nan, 0.9999]), np.array([165.9033, nan]), np.array([165.9029, nan]),
+              np.array([165.9028, nan])]
+    _, estimate = levels.extrapolate(values, ORDER)
+    assert estimate == math.inf

@@ -135,10 +135,12 @@ def bracketed_newton(f, fprime, lo: float, hi: float, x: float) -> float:
             hi = x
         d = fprime(x)
         x_new = x - fx / d if d > 0.0 else math.nan
+        if abs(x_new - x) <= 4.0 * _EPS * abs(x):
+            return x_new  # converged (before the bracket test: x is now one of its ends)
         if not lo < x_new < hi:
             x_new = 0.5 * (lo + hi)
-        if abs(x_new - x) <= 4.0 * _EPS * abs(x_new) or not lo < x_new < hi:
-            return x_new
+            if not lo < x_new < hi:
+                return x_new
         x = x_new
     return x
 

@@ -106,6 +106,9 @@ def extrapolate(values: Sequence[np.ndarray], order: Order,
     alone on a scene the levels solve exactly).
     """
     v = [np.asarray(x, dtype=float) for x in values[-4:]]
+    if any(not np.array_equal(np.isnan(x), np.isnan(v[-1])) for x in v[:-1]):
+        # An event (detachment) found on some levels only: not converged.
+        return v[-1].copy(), math.inf
     raw_estimate, measured = richardson(v[-3:], order, floor)
     if not math.isfinite(measured) or measured < DIVERGING_ORDER:
         # Outputs unchanged, levels not converging, or (an exact scene) differing by rounding
