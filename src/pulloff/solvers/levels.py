@@ -114,8 +114,7 @@ def extrapolate(values: Sequence[np.ndarray], order: Order,
         # Outputs unchanged, levels not converging, or (an exact scene) differing by rounding
         # alone: the finest level, with the larger of its last two changes as the estimate.
         return v[-1].copy(), raw_estimate
-    f = 1.0 / (2.0 ** order.high - 1.0)
-    e = [fine + (fine - coarse) * f for coarse, fine in zip(v[:-1], v[1:])]
+    e = _pairwise(v, order.high)
     scale = _scale(e[-1], floor)
     mask = np.all([np.isfinite(x) for x in e], axis=0) & (scale != 0)
     if not np.any(mask):
@@ -154,14 +153,19 @@ def extrapolate_measured(values: Sequence[np.ndarray], order: Order,
         same = np.array_equal(v1, v2, equal_nan=True)
         return v2.copy(), (0.0 if same else math.inf)
     p = min(order.high, max(order.low, measured))
-    f = 1.0 / (2.0 ** p - 1.0)
-    e1 = v1 + (v1 - v0) * f
-    e2 = v2 + (v2 - v1) * f
+    e1, e2 = _pairwise([v0, v1, v2], p)
     scale = _scale(e2, floor)
     mask = np.isfinite(e2) & np.isfinite(e1) & (scale != 0)
     if not np.any(mask):
         return e2, 0.0
-    return e2, float(np.max(np.abs(e2 - e1)[mask] / scale[mask]) * f)
+    return e2, float(np.max(np.abs(e2 - e1)[mask] / scale[mask]) * (1.0 / (2.0 ** p - 1.0)))
+
+
+def _pairwise(v: Sequence[np.ndarray], p: float) -> list[np.ndarray]:
+    """The Richardson extrapolation at order ``p`` of each pair of consecutive levels (step
+    ratio 2), coarsest pair first."""
+    f = 1.0 / (2.0 ** p - 1.0)
+    return [fine + (fine - coarse) * f for coarse, fine in zip(v[:-1], v[1:])]
 
 
 _EXTRAPOLATIONS = {"method": extrapolate, "measured": extrapolate_measured}
