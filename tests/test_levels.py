@@ -113,3 +113,14 @@ def test_an_event_missing_on_a_coarse_level_is_not_converged():
               np.array([165.9028, nan])]
     _, estimate = levels.extrapolate(values, ORDER)
     assert estimate == math.inf
+
+
+def test_extrapolations_that_stop_changing_keep_the_previous_change_as_estimate():
+    """Extrapolations off by 1.3e-6, then 0 and 0 (a change of exactly 0): the guard from
+    the change before still holds (the review found an estimate of 0 here)."""
+    e_true = [1.3e-6, 0.0, 0.0]
+    v = [np.array([1.0 + 1e-4])]
+    for err in e_true:
+        v.append(np.array([(3.0 * (1.0 + err) + v[-1][0]) / 4.0]))
+    _, estimate = levels.extrapolate(v, ORDER)
+    assert estimate > 1e-8

@@ -124,9 +124,10 @@ def extrapolate(values: Sequence[np.ndarray], order: Order,
         return e[-1], float(np.max(d_last))
     d_prev = np.abs(e[-2] - e[-3])[mask] / scale[mask]
     worst = int(np.argmax(d_last))
-    if d_last[worst] == 0.0:
+    if d_last[worst] == 0.0 and d_prev[worst] == 0.0:
         return e[-1], 0.0
-    q = math.log2(d_prev[worst] / d_last[worst]) if d_prev[worst] > 0 else math.inf
+    q = (math.log2(d_prev[worst] / d_last[worst]) if d_prev[worst] > 0 and d_last[worst] > 0
+         else math.inf)
     if q < DIVERGING_ORDER:
         return e[-1], float(max(d_last[worst], d_prev[worst]))
     q = min(order.high, max(order.low, q))
