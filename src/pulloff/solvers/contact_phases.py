@@ -22,6 +22,11 @@ class Lost(Exception):
 
 
 _XTOL = 1e-14
+#: A Newton correction below this share of the root ends the search without a bracket once
+#: the residual is below ``_SMALL_RESIDUAL`` (measured: the gap's rounding floor is
+#: 1e-13..1e-11, where the last iterates repeat without changing sign).
+_STALL = 1e-13
+_SMALL_RESIDUAL = 1e-9
 #: How far a jump's search looks, in the larger of the last state, the predictor and the unit
 #: of length: a state ten thousand times further is no state of the scene (measured: without
 #: a bound, a tabulated tip's searches ran to 1e27 at 400 evaluations each).
@@ -37,9 +42,12 @@ def _secant(f, x_held, f_held, x_guess, lo, hi, reach):
         return None
     f1 = f(x1)
     bracket = None
+    slope = math.nan
     for _ in range(40):
         if math.isnan(f1):
             return None
+        if abs(x1 - x0) > 1e-9 * max(abs(x1), 1e-300):  # a chord rounding does not decide
+            slope = _chord(x0, f0, x1, f1)
         if f1 == 0.0 or abs(f1) <= 1e-14:
             return x1
         if (f1 > 0.0) != (f0 > 0.0):
@@ -49,6 +57,10 @@ def _secant(f, x_held, f_held, x_guess, lo, hi, reach):
         if abs(x1 - x0) <= _XTOL * max(abs(x1), 1e-300) and bracket is not None:
             return x1
         x2 = x1 - f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else math.nan
+        if (abs(f1) <= _SMALL_RESIDUAL and abs(f1) <= abs(slope) * _STALL * max(abs(x1), 1e-300)):
+            # The residual's rounding floor (~1e-12 of delta) hides the sign change: a
+            # Newton correction this small (on a chord wide enough to trust) is convergence.
+            return x1
         if bracket is not None and not bracket[0] < x2 < bracket[1]:
             x2 = 0.5 * (bracket[0] + bracket[1])
         if not (lo <= x2 <= hi) or abs(x2 - x_held) > reach:
@@ -64,6 +76,10 @@ def _secant(f, x_held, f_held, x_guess, lo, hi, reach):
                 bracket = (min(keep, x2), max(keep, x2))
         x0, f0, x1, f1 = x1, f1, x2, f2
     return None
+
+
+def _chord(x0, f0, x1, f1):
+    return (f1 - f0) / (x1 - x0) if x1 != x0 else math.nan
 
 
 def _bracketed(f, a, fa, b, fb):

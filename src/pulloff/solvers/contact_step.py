@@ -73,6 +73,9 @@ class Step:
         self._free = None  # (x, modes) of the free elements at the start, gathered once
         self.k_alpha = self.k_beta = 0  # new elements per step (set by the stepper)
         self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv)
+        # The phase searches come back to points they have evaluated (the held edge, the
+        # root they end on): a step answers those from its memo.
+        self._memo = {}
         setup = stepper.setup
         ind = setup.indenter
         sc = np.zeros(17)
@@ -167,7 +170,14 @@ class Step:
     # --- the free side -------------------------------------------------------------------
     def evaluate(self, alpha, beta, H_new) -> Evaluation:
         """The end of the step for trial edges and lift (:func:`pulloff.kernels.contact.
-        evaluate_step` advances every element)."""
+        evaluate_step` advances every element); a repeated trial is answered from the memo."""
+        key = (alpha, beta, H_new, self.k_alpha, self.k_beta, self.jump, self.s.nodes.n)
+        ev = self._memo.get(key)
+        if ev is None:
+            ev = self._memo[key] = self._evaluate(alpha, beta, H_new)
+        return ev
+
+    def _evaluate(self, alpha, beta, H_new) -> Evaluation:
         s = self.s
         nodes = s.nodes
         law = s.setup.law

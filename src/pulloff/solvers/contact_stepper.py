@@ -39,6 +39,8 @@ ENTRY_NODES = 4
 #: A step that went further than this many targets (``1/n`` of the measure) is redone.
 REDO_MEASURE = 4.0
 MAX_STEPS = 40_000
+#: The first step after an event, as a share of the step before it.
+RESTART_SHRINK = 16.0
 
 
 class NoSolution(Exception):
@@ -212,7 +214,9 @@ class Stepper:
             rate = self._measure(before, now, dt_prev) / dt_prev
             dt = min(1.0 / (self.n * rate), 2.0 * dt_prev)
         elif self.last_dt is not None:
-            dt = min(dt, self.last_dt)
+            # After an event the edges may start like sqrt(t - t_event) (a zone left alone, an
+            # edge set free): the first step is a fraction of the last, and doubling regrows it.
+            dt = min(dt, self.last_dt / RESTART_SHRINK)
         # A step must move the clock: below its resolution the run would stand still.
         dt = max(dt, 64 * np.finfo(float).eps * max(abs(now.t), self.t_scale))
         return min(dt, t_end - now.t, self._segment_left())
