@@ -79,6 +79,10 @@ def scenes():
     out["separation_kv_v1e-2"] = dict(out["separation_kv"], v=1e-2)
     out["sls_finite_punch_v1e-4"] = dict(out["sls_finite_punch"], v=1e-4)
     out["sls_external_v1e-2"] = dict(out["sls_finite_punch"], zone="external", v=1e-2)
+    # A Kelvin-Voigt face whose strength limits the bond (chi_R = 0.94), behind 1 kN/m.
+    out["finite_punch_spring_kv"] = dict(G_inf=1e6, eta=1e3, arms=(), sigma_c=1e6, delta=3e-6,
+                                         R=1e-5, v=1e-3, h0=0.0, zone="internal",
+                                         machine_stiffness=1e3)
     return out
 
 

@@ -148,6 +148,24 @@ def test_dmt_like_sphere_matches_maugis_dugdale_and_tends_to_dmt(lam):
     assert res.F_pulloff / dmt > run(1.0).F_pulloff / dmt
 
 
+def test_dmt_like_sphere_leaves_at_its_zone_fold_at_every_resolution():
+    """lambda = 0.1: the zone alone folds at a finite radius while it still pulls, and the
+    force drops to zero at once. With coarse steps the zone's b^2 was once extrapolated to 0
+    past the fold: n = 16, 32, 64 came apart 1.8e-3, 9.8e-4, 4.5e-4 (in time scales) late and
+    without the jump, n >= 128 at the fold; the ladder then refined to n = 1024."""
+    scene = path_scene(0.1)
+    setup = contact_setup.setup(scene)
+    ends = []
+    for n in (16, 128):
+        stepper = Stepper(setup, n, contact._time_scale(scene, setup))
+        stepper.run(1e9)
+        ends.append(stepper.events[-3:])
+        assert [name for _, name in ends[-1]] == ["zone", "jump_out", "separated"]
+        assert stepper.rows[-2][3] > 0.0  # the last zone still had a radius
+    # The fold is located by root finding: the levels agree far below the step.
+    assert ends[0][0][0] == pytest.approx(ends[1][0][0], rel=1e-9)
+
+
 def test_sphere_behind_a_stiff_machine_spring_runs_the_path():
     """Behind a spring the driver starts where it holds the indenter (it once started at 0, so
     the tip leapt down and the path ended apart at once), and the zone's jump into contact

@@ -36,6 +36,11 @@ integral *exactly* from that history:
   smallest ~N^-2/3 of the nominal step) away from the start and towards the end of each
   segment. In the bonded phase under a rigid machine ``b(t)`` (external) or ``a(t)``
   (internal) is explicit and used exactly: the onset carries no time-discretisation error.
+  Behind a machine spring the internal zone's bonded path is an ODE in ``theta = asin(s/R)``
+  (:class:`_SpringPath`; the point-by-point force balance is unstable there), integrated to
+  ~1e-13 and interpolated in theta, so its onset or strength limit carries no
+  time-discretisation error either; after the strength limit the zone holds the whole face
+  (``a = 0``, ``b = R``, ``h = v t - pi R^2 sigma_c/k_m``) until gap(R) = delta.
 * Steps are of unit "chord" ``sqrt((dt/dt2)^2 + (dy/dY)^2)`` with ``dt2 = t2/N`` and
   ``dY = min(R^2, 2 (a^2 + s^2)) / N`` (so thin zones keep resolving ``a`` down to the zone
   width); each fixes whichever of ``t`` or ``y`` moves more and solves the scalar condition
@@ -670,6 +675,84 @@ def _modes(G_inf, eta, arms):
     return 1.0 / (4.0 * G_inf), np.zeros(0), np.zeros(0), np.zeros(0)
 
 
+class _SpringPath:
+    """Bonded phase of an internal zone behind a machine spring ``k_m``, in the angle theta:
+    ``s = q_b/(2 sigma_c) = R sin(theta)``, ``a = R cos(theta)``.
+
+    Why not the force balance solved point by point on the interpolated load history (as the
+    external zone does): that is an Adams-Moulton recursion for ``s``, unstable once
+    ``k_m dt`` exceeds the bonded disc's damping ``8 eta a`` (spring and damper in series), and
+    ``a -> 0`` at the strength limit makes the ratio unbounded; there, moreover,
+    ``a ~ (t_sl - t)^(1/3)``, so no path in time is smooth. In theta the path is analytic up to
+    and including ``theta = pi/2`` (``t_sl - t ~ (pi/2 - theta)^3``): with the modes of the
+    reference element, ``u_r = alpha0 q + sum_m y_m``, ``y_m' = lam_m y_m + cw_m q``,
+    ``q = 2 sigma_c R sin(theta)``, the balance ``k_m (v t - u_r) = F(theta)`` gives
+
+        dy_m/dtheta = (lam_m y_m + cw_m q) dt/dtheta,
+        dt/dtheta = (F'(theta) + 2 k_m alpha0 sigma_c R cos(theta)) / (k_m (v - sum_m y_m')),
+
+    ``F = sigma_c R^2 (2 theta + sin(2 theta))`` (the total force), ``F' = 4 sigma_c R^2
+    cos^2(theta)``; ``t`` itself comes from the balance (no drift). Integrated to ~1e-13
+    (DOP853, dense output); an elastic solid has no modes and ``t(theta)`` in closed form.
+    ``theta_end < pi/2`` if ``v - sum y'`` reaches 0 first (the spring would stop stretching:
+    not modelled)."""
+
+    def __init__(self, alpha0, lam, cw, sigma, R, v, km):
+        self.alpha0, self.lam, self.cw = alpha0, np.asarray(lam), np.asarray(cw)
+        self.sigma, self.R, self.v, self.km = sigma, R, v, km
+        self.sol = None
+        self.theta_end = 0.5 * math.pi
+        if self.lam.size:
+            self._integrate()
+
+    def force(self, th):
+        return self.sigma * self.R ** 2 * (2.0 * th + math.sin(2.0 * th))
+
+    def _rates(self, th, y):
+        """(dy/dtheta, v - sum y') [m, m/s] at theta."""
+        sR = self.sigma * self.R
+        r = self.lam * y + self.cw * (2.0 * sR * math.sin(th))
+        nv = self.v - float(np.sum(r))
+        c = math.cos(th)
+        dt = (4.0 * sR * self.R * c * c + 2.0 * self.km * self.alpha0 * sR * c) / (self.km * nv)
+        return r * dt, nv
+
+    def _integrate(self):
+        from scipy.integrate import solve_ivp
+
+        def stop(th, y):
+            return self._rates(th, y)[1]
+
+        stop.terminal, stop.direction = True, -1
+        # length scale of u_r: the spring's stretch plus the relaxed response to 2 sigma_c R
+        lam_abs = np.where(self.lam != 0.0, np.abs(self.lam), np.inf)
+        ell = self.force(0.5 * math.pi) / self.km + 2.0 * self.sigma * self.R * (
+            self.alpha0 + float(np.sum(self.cw / lam_abs)))
+        sol = solve_ivp(lambda th, y: self._rates(th, y)[0], (0.0, 0.5 * math.pi),
+                        np.zeros(self.lam.size), method="DOP853", rtol=1e-13,
+                        atol=1e-16 * ell, dense_output=True, events=stop)
+        # a failed integration (dt/dtheta -> inf as v - sum y' -> 0) still holds up to sol.t[-1]
+        self.sol = sol.sol
+        self.theta_end = float(sol.t[-1])
+
+    def t(self, th):
+        """Time [s] at which the bonded path reaches theta."""
+        u = self.alpha0 * 2.0 * self.sigma * self.R * math.sin(th)
+        if self.sol is not None:
+            u += float(np.sum(self.sol(th)))
+        return (u + self.force(th) / self.km) / self.v
+
+    def mesh(self, dt1, dth1):
+        """Points 0 = theta_0 < ... < theta_n = theta_end of unit chord
+        ``sqrt((dt/dt1)^2 + (dtheta/dth1)^2)`` (a smooth grading, ends exactly at theta_end)."""
+        th = np.linspace(0.0, self.theta_end, 4097)
+        tt = np.array([self.t(x) for x in th])
+        dens = np.hypot(np.gradient(tt, th) / dt1, 1.0 / dth1)
+        cum = np.concatenate(([0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(th))))
+        n = max(4, int(math.ceil(cum[-1])))
+        return np.interp(np.linspace(0.0, cum[-1], n + 1), cum, th)
+
+
 # --------------------------------------------------------------------------------------------
 # One resolution
 # --------------------------------------------------------------------------------------------
@@ -692,6 +775,8 @@ class _Seg:
         self.dy = dy
         self.u = [0.0]
         self.fix = {}  # point (relative index) -> coordinate held fixed in its solve
+        self.by_u = False  # interpolate in u (a smooth path parameter), never in time
+        self.deg = None  # degree of the local interpolants (None: EdgeRun.DEG)
 
 
 class EdgeRun:
@@ -807,7 +892,7 @@ class EdgeRun:
     def _stencil(self, seg, k, L):
         """Points of the local interpolant of step k (segment points i0..L, L the newest)."""
         i0 = seg.i0
-        D = self.DEG
+        D = seg.deg or self.DEG
         if L - i0 <= D:
             return list(range(i0, L + 1))
         st = min(max(k - (D - 1) // 2, i0), L - D)
@@ -850,7 +935,7 @@ class EdgeRun:
                 dYk = yv[k + 1] - yv[k]
                 steep = abs(dYk) / seg.dy > abs(dTk) / seg.dt
                 cands = [yv, self.T] if steep else [self.T, yv]
-            else:
+            elif not seg.by_u:
                 cands = [self.T]
             for V in cands:
                 den = V[k + 1] - V[k]
@@ -998,6 +1083,12 @@ class EdgeRun:
             _, Ft = _forces(self.R2 + self.DA[L], self.R2 + self.DB[L], s, self.sigma)
             return self.km * (self.v * t - ur) - Ft
 
+        if not resid(0.0) > 0.0:
+            # the driver is behind the reference element even without load: the recursion for
+            # s (Adams-Moulton-like) has gone unstable, k_m dt >~ 8 eta a (see _SpringPath)
+            raise RuntimeError("force balance behind the spring lost its root (the step is "
+                               "long for the spring's relaxation 8 eta a / k_m): not solved "
+                               "in this phase")
         s_prev = self.SQ[L - 1]
         hi = max(2.0 * s_prev, 1e-6 * self.R)
         while resid(hi) > 0:
@@ -1065,6 +1156,8 @@ class EdgeRun:
 
     # ---------------------------------------------------------------- phase 1 (bonded)
     def run_phase1(self):
+        if not self.external and self.km is not None:
+            return self._run_phase1_spring()
         ym = _Y_EXT1 if self.external else _Y_INT1
         exact = self.km is None
         sm = _S_EXACT if exact else _S_INTERP
@@ -1104,6 +1197,112 @@ class EdgeRun:
         self.events["onset"] = L
         self._ft_onset = (g_prev, t_prev)
         self.segs[0].i1 = L
+
+    def _run_phase1_spring(self):
+        """Internal zone behind a spring: the bonded phase on the theta path (_SpringPath),
+        points on its mesh until gap(R) = delta (the onset) or theta = pi/2 (the strength
+        limit, then the pinned stage up to gap(R) = delta)."""
+        self._spath = _SpringPath(self.alpha0, self.lam, self.cw, self.sigma, self.R, self.v,
+                                  self.km)
+        seg = _Seg(0, _Y_INT1, _S_INTERP, False, self.dt1, None)
+        seg.by_u = True  # u = theta: t(theta) and s(theta) are analytic, t(s) and s(t) are not
+        self.segs = [seg]
+        self._set_point(0, 0.0, None, _Y_INT1, 0.0)
+        self.breaks_X2 = [self.DA[0]]
+        ths = self._spath.mesh(self.dt1, 0.5 * math.pi / self.N)
+        g_prev = (0.0, 0.0)
+        for L in range(1, ths.size):
+            f = self._theta_trial(L, float(ths[L]))
+            if f >= 0.0:
+                L = self._land_theta(L)
+                self.L = L
+                self.events["onset"] = L
+                self._ft_onset = g_prev
+                seg.i1 = L
+                return
+            g_prev = (f + self.delta, self.T[L])
+            if self.t_max is not None and self.T[L] > self.t_max:
+                raise RuntimeError("no onset before t_max")
+        if self._spath.theta_end < 0.5 * math.pi:
+            raise RuntimeError("behind the spring the bonded punch stops stretching it before "
+                               "the onset (v - dh/dt -> 0): not modelled")
+        # theta = pi/2: q_b = 2 sigma_c R, a = 0, F = pi R^2 sigma_c (MODEL.md 6)
+        self.events["strength_limit"] = float(self.T[L])
+        self._i_sl = L
+        seg.i1 = L
+        self._run_pinned(L)
+
+    def _theta_trial(self, L, th):
+        """Point L of the theta path at theta = th; returns gap - delta [m]."""
+        seg = self.segs[0]
+        self._declare(L, 0)
+        self._set_point(L, self._spath.t(th), None, _Y_INT1, self.R * math.sin(th))
+        del seg.u[L - seg.i0:]
+        seg.u.append(th)
+        self._fit(seg, L)
+        return self.gap(L) - self.delta
+
+    def _land_theta(self, L):
+        """Make point ``L`` of the theta path the onset (gap = delta inside its step): first on
+        the step's truncated interpolants (dense output), then as a proper point (dropping the
+        previous point if it is too close); returns the onset's index."""
+        seg, k = self.segs[0], L - 1
+        th0, th1 = seg.u[k], seg.u[L]
+        tco_full, sco_full = self.tco[k].copy(), self.sco[k].copy()
+
+        def dense(x):
+            p = (x - th0) / (th1 - th0)
+            sc = p ** np.arange(_NC)
+            self.tco[k], self.sco[k] = tco_full * sc, sco_full * sc
+            self._set_point(L, _poly(tco_full, p), None, _Y_INT1, _poly(sco_full, p))
+            _prep(k, L, self.T, self.ymode, self.smode, self.tco, self.yco, self.sco, self.sp,
+                  self.lam, self.sigma, _GX, _GW, self.dBg, self.Kg, self.Ok, self.dBx,
+                  self.stiff)
+            return self.gap(L) - self.delta
+
+        x = brentq(dense, th0, th1, xtol=1e-300, rtol=8.9e-16, maxiter=200)
+        if x - th0 < 0.2 * (th1 - th0) and L >= 2:
+            L -= 1  # a step much shorter than its neighbours would spoil the interpolants
+        prev = seg.u[L - 1]
+        lo, hi = prev + 0.5 * (x - prev), min(th1, x + 0.5 * (th1 - th0))
+        G = lambda y: self._theta_trial(L, y)
+        while G(hi) < 0.0 and hi < self._spath.theta_end:
+            hi = min(hi + 0.5 * (th1 - th0), self._spath.theta_end)
+        while G(lo) > 0.0 and lo > prev + 1e-3 * (th1 - th0):
+            lo = prev + 0.5 * (lo - prev)
+        G(brentq(G, lo, hi, xtol=1e-300, rtol=8.9e-16, maxiter=200))
+        return L
+
+    def _run_pinned(self, L):
+        """After the strength limit behind a spring: ``a = 0``, the zone fills the face
+        (``b = R``), ``F = pi R^2 sigma_c`` and the lift ``h = v t - F/k_m`` is explicit; the
+        reference element keeps its load ``2 sigma_c R`` (frozen: continuous at t_sl; the gap
+        adds ``h - u_r``). The path is exactly linear in time here (one-step interpolants), so
+        the steps only bound the per-step quadrature (|lam| dt <= 1); the point where
+        gap(R) = delta becomes the "onset" index, the zone-only phase starts there."""
+        seg = _Seg(L, _Y_B, _S_FROZEN, False, self.dt2, self.dY)
+        seg.deg = 1
+        self.segs.append(seg)
+        si = len(self.segs) - 1
+        rate = float(np.max(np.abs(self.lam))) if self.M else 0.0
+        dt = min(self.dt2, 1.0 / rate) if rate > 0 else self.dt2
+        i = L
+        while True:
+            t = self.T[i] + dt
+            if self.trial(i + 1, t, 0.0, si, True) >= 0.0:
+                break
+            i += 1
+            if self.t_max is not None and t > self.t_max:
+                raise RuntimeError("no onset (gap(R) = delta) before t_max")
+        t0 = self.T[i]
+        lo = t0 + 1e-9 * dt  # a zero-length step has no interpolant
+        G = lambda tt: self.trial(i + 1, tt, 0.0, si, True)
+        ton = lo if G(lo) >= 0.0 else brentq(G, lo, t, xtol=1e-300, rtol=8.9e-16, maxiter=200)
+        G(ton)
+        self.L = i + 1
+        self.events["onset"] = i + 1
+        self._ft_onset = None
+        seg.i1 = i + 1
 
     def _strength_limit_time(self, L, t, exact):
         """Internal zone: when the bonded line load reaches 2 sigma_c R inside step ``L``
@@ -1485,7 +1684,7 @@ class EdgeRun:
     def _h_out(self, i):
         if self.km is None:
             return self.h0 + self.v * self.T[i]
-        a0 = self.events.get("a_zero")
+        a0 = getattr(self, "_i_sl", self.events.get("a_zero"))  # explicit lift from a = 0 on
         if a0 is not None and i > a0:
             return self._h(i, True)
         return _ref_u(i, self.T, self.SQ, self.Ok, self.lam, self.cw, self.alpha0, self.sigma)
@@ -1677,16 +1876,17 @@ def _pilot_scales(params, t_max):
                         params["h0"], params["zone"] == "external")
     if not t1 > 0:
         t1 = params["delta"] / params["v"]
-    pilot = None
+    pilot = err = None
     for n_pilot in (8, 16):
         try:
             pilot = _one_level(params, n_pilot, (t1, t1, R * R), t_max, False)
-        except (RuntimeError, _NoRoot, FloatingPointError, np.linalg.LinAlgError):
+        except (RuntimeError, _NoRoot, FloatingPointError, np.linalg.LinAlgError) as e:
+            err = e
             continue
         if pilot["separation_kind"] != "lost_branch":
             break
     if pilot is None:
-        raise RuntimeError("pilot run failed")
+        raise RuntimeError(f"pilot run failed: {err}") from err
     t_on = pilot["t_onset"]
     t1s = t_on if t_on > 0 else t1
     t2s = pilot["t_separation"] - t_on
