@@ -49,11 +49,19 @@ def spring_scene(rtol):
         "model": {"until": "detach"}, "numerics": {"rtol": rtol}})
 
 
+#: The reference's scenes at other speeds: (config, overrides).
+VARIANTS = {"separation_kv_v1e-2": ("separation_kv", ["loading.v=1e-2"]),
+            "sls_finite_punch_v1e-4": ("sls_finite_punch", ["loading.v=1e-4"]),
+            "sls_external_v1e-2": ("sls_finite_punch", ["loading.v=1e-2",
+                                                        "geometry.cohesive_zone=external"])}
+
+
 def scene(name, rtol):
     if name == "finite_punch_spring_kv":
         return spring_scene(rtol)
-    return load_scene(ROOT / "configs" / f"{name}.yaml",
-                      overrides=[f"numerics.rtol={rtol}", "model.until=separation"])
+    config, extra = VARIANTS.get(name, (name, []))
+    return load_scene(ROOT / "configs" / f"{config}.yaml",
+                      overrides=[f"numerics.rtol={rtol}", "model.until=separation"] + extra)
 
 
 def worst_error(result, ref):
@@ -70,7 +78,9 @@ def worst_error(result, ref):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4])
-    ap.add_argument("--only", nargs="*", default=None)
+    ap.add_argument("--only", nargs="*", default=None,
+                    help=f"scene names (default: {', '.join(SHIPPED)}, finite_punch_spring_kv; "
+                         f"also {', '.join(VARIANTS)})")
     args = ap.parse_args(argv)
     names = args.only or list(SHIPPED) + ["finite_punch_spring_kv"]
     solvers.simulate(scene(names[0], 1e-2))  # compile outside the timings
