@@ -65,8 +65,10 @@ OUTPUTS = (
     _s("t_separation", "s", "complete separation: the zone has vanished", "separation"),
     _s("F_peak_contact", "N", "largest F_contact of the run", "separation"),
     _s("F_peak_total", "N", "largest F_total of the run (the pull-off force)", "separation"),
-    _s("t_peak_contact", "s", "time of the largest F_contact", "separation"),
-    _s("t_peak_total", "s", "time of the largest F_total", "separation"),
+    _s("t_peak_contact", "s", "time of the largest F_contact (not error-controlled: the time "
+                              "of a smooth maximum is ill-conditioned)", "separation"),
+    _s("t_peak_total", "s", "time of the largest F_total (not error-controlled, likewise)",
+       "separation"),
     _s("F_pulloff", "N", "the most tensile F_total of the path (the pull-off force)", "path"),
     _s("h_pulloff", "m", "lift at F_pulloff (not error-controlled: the place of a smooth "
                          "maximum is ill-conditioned)", "path"),
