@@ -286,3 +286,23 @@ def test_gap_from_integral_matches_definition():
     b = math.sqrt(1 + S * S)
     direct = h - (2 / math.pi) * (h * math.asin(1 / b) + integral)
     assert K.gap_from_integral(h, S, integral) == pytest.approx(direct, rel=1e-13)
+
+
+def test_free_gap_integral_extrapolates_the_end_value_from_beyond_a_kink():
+    """A receding zone over a flat punch's first bond edge: the displacement has a kink there
+    (bonded inside, zone-loaded beyond). The end value comes from the nodes beyond the kink
+    alone (once a stencil across it made the gap jump by 1.3e-2 delta as the end passed a
+    node, and separation_kv at 1e-2 m/s came apart 2 % early at some levels)."""
+    from pulloff.kernels import contact as C
+
+    beta, kink = 1.2, 1.0
+    theta = np.concatenate([[0.25, 0.45], np.linspace(0.65, 1.4, 6)])  # two beyond the kink
+    xi = np.sort(beta * np.cos(theta))
+    th = np.arccos(xi / beta)
+    U = np.where(xi > kink, 1.0 + 2.0 * th, 2.2 + 0.3 * (th - math.acos(kink / beta)) ** 2)
+    n = xi.size
+    given_end = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], 1.0)
+    beyond = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan, kink)
+    across = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan)
+    assert beyond == pytest.approx(given_end, rel=1e-13)
+    assert abs(across - given_end) > 1e-4 * abs(given_end)

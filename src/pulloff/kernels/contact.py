@@ -492,11 +492,12 @@ def free_field(xi, Y0, s0, lo, hi, p0, p1, p2, mus, zdt, ctil, d, nm, w3, Y_out,
 
 
 @njit(cache=True)
-def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta):
+def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta, kink=0.0):
     """``int_alpha^beta U / sqrt(beta^2 - xi^2) dxi = int_0^theta_a U dtheta`` with
     ``xi = beta cos(theta)``: the piecewise cubic through the nodes strictly inside, ``U_alpha``
     at the contact edge and ``U_beta`` at the zone end (nan: extrapolated from the nodes next to
-    it, where ``U`` is smooth in ``theta``)."""
+    it, where ``U`` is smooth in ``theta``; only from those beyond ``kink``, where ``U`` has a
+    kink inside the zone and at least two nodes lie between it and the end)."""
     n_in = 0
     for i in range(lo, hi):
         if alpha < xi[i] < beta:
@@ -524,7 +525,16 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta):
     f[k] = f[m - 1]
     m = k + 1
     if math.isnan(U_beta):
-        f[0] = extrapolate_cubic(th[1:], f[1:], m - 1, 0.0)
+        usable = m - 1
+        if 0.0 < kink < beta:
+            # The nodes are in ascending theta: those beyond the kink come first.
+            th_kink = angle(kink, beta)
+            smooth = 0
+            while smooth < m - 2 and th[smooth + 1] < th_kink:
+                smooth += 1
+            if smooth >= 2:
+                usable = smooth
+        f[0] = extrapolate_cubic(th[1:], f[1:], usable, 0.0)
     else:
         f[0] = U_beta
     return piecewise_cubic_integral(th, f, m)
@@ -535,7 +545,7 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta):
 R_GAP, R_EDGE_LOAD, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(6)
 #: Indices of the step constants ``sc`` of :func:`evaluate_step`.
 (S_T0, S_DT, S_ALPHA0, S_BETA0, S_H1, S_HDOT, S_XIMAX, S_KAPPA, S_C, S_D, S_FLAT, S_AF, S_C_G,
- S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH) = range(17)
+ S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH, S_KINK) = range(18)
 
 
 @njit(cache=True)
@@ -788,7 +798,7 @@ def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
     virgin = beta1 > sc[S_XIMAX] * (1.0 + 1e-12) and beta1 > sc[S_BETA0]
     U_beta = 0.0 if virgin else math.nan
     U_alpha = H1 + _profile(sc, alpha1, prof) if alpha1 > 0.0 else centre
-    integral = free_gap_integral(xs, us, 0, n_in, alpha1, beta1, U_alpha, U_beta)
+    integral = free_gap_integral(xs, us, 0, n_in, alpha1, beta1, U_alpha, U_beta, sc[S_KINK])
     return integral
 
 

@@ -78,13 +78,16 @@ class Step:
         self._memo = {}
         setup = stepper.setup
         ind = setup.indenter
-        sc = np.zeros(17)
+        sc = np.zeros(18)
         # An elastic smooth contact has no history: each evaluation places its own elements.
         self.fresh = not setup.flat and law.c == 0.0 and not law.maxwell
         sc[[K.S_T0, K.S_DT, K.S_ALPHA0, K.S_BETA0, K.S_XIMAX, K.S_KAPPA, K.S_C, K.S_D,
             K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G, K.S_FRESH]] = (
             now.t, dt, now.alpha, now.beta, stepper.nodes.xi_max, law.kappa_inf, law.c, law.d,
             1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n, 1.0 if self.fresh else 0.0)
+        # A flat punch's first bond edge: inside it the elements were bonded, beyond it
+        # loaded by the zone, and their displacement has a kink there.
+        sc[K.S_KINK] = (stepper.rows[0][2] if stepper.rows else now.alpha) if setup.flat else 0.0
         self._constants = sc
 
     @property
