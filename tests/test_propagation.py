@@ -223,6 +223,20 @@ def test_machine_force_balance_holds_at_every_row(k_m):
     assert delay > 0.5 * rigid.F_total_detach / (k_m * res.problem.v)
 
 
+def test_a_soft_spring_stretches_within_the_run_s_time_scale():
+    """Behind 1 N/m the onset comes at 1.4376 s (measured at rtol 1e-2 and 1e-4, estimate
+    3e-6; the force 1.4280 mN, between the 100 N/m one and the elastic closed form 1.4332 mN),
+    150 frozen onset times in: the time scale once ignored the spring, so the default span
+    (1.06 s) ended before the onset, after 436 s of steps 150 times too short. Now the scale is
+    the spring's stretch F/(k v) where that is longer."""
+    scene = load_scene(CONFIGS / "separation_kv.yaml",
+                       overrides=["loading.machine_stiffness=1", "model.until=detach"])
+    setup = contact_setup.setup(scene)
+    t_scale = contact._time_scale(scene, setup) * setup.T
+    assert contact.DEFAULT_SPAN * t_scale > 1.4376
+    assert 0.5 < 1.4376 / t_scale < 2.0  # steps of ~1/n of the onset, not of 1/150 of it
+
+
 def test_compliant_machine_onset_matches_the_reference():
     """compliant_machine.yaml up to its onset, against pulloff.references.edge."""
     ref = REFERENCE["compliant_machine"]

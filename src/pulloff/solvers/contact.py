@@ -134,8 +134,21 @@ def _time_scale(scene, setup) -> float:
     """The run's time scale (steps are about ``1/n`` of it where nothing moves fast): the
     frozen-history onset bound of a flat punch's pull, else the path's known durations."""
     if scene.loading.kind == "constant_velocity":
-        t = frozen_detach_time(Problem.from_scene(scene), math.inf)
-        return t if math.isfinite(t) and t > 0.0 else 1.0
+        problem = Problem.from_scene(scene)
+        t = frozen_detach_time(problem, math.inf)
+        t = t if math.isfinite(t) and t > 0.0 else 1.0
+        k_m = scene.loading.machine_stiffness
+        if k_m is not None:
+            # Behind a spring the onset comes about F/(k_m v) later (the spring stretches
+            # first): behind 1 N/m that was 150 frozen onset times, past the default span,
+            # and every level took ~150 times the steps it needed. The larger of the two
+            # (their sum moved a stiff spring's levels: a finite punch behind 1 kN/m then
+            # converged less regularly).
+            force = (math.pi * problem.a ** 2 * problem.sigma_c
+                     if scene.geometry.cohesive_zone == "internal"
+                     else float(problem.total_force(t)))
+            t = max(t, force / (k_m * problem.delta))
+        return t
     # A path's own progress (lift, force, edges) sizes its steps; time only bounds them.
     known = [d.end[1] for d in setup.drives if d.end[0] == "time"]
     return max(known + [1e3])
