@@ -140,8 +140,8 @@ def _time_scale(scene, setup) -> float:
         k_m = scene.loading.machine_stiffness
         if k_m is not None:
             # Behind a spring the onset comes about F/(k_m v) later (the spring stretches
-            # first): behind 1 N/m that was 150 frozen onset times, past the default span,
-            # and every level took ~150 times the steps it needed. The larger of the two
+            # first): behind 1 N/m that was 135 frozen onset times, past the default span,
+            # and every level took ~135 times the steps it needed. The larger of the two
             # (their sum moved a stiff spring's levels: a finite punch behind 1 kN/m then
             # converged less regularly).
             force = (math.pi * problem.a ** 2 * problem.sigma_c

@@ -21,7 +21,8 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
     delta), and that lift starts the search if it does not. ``H_travel`` is the lift's
     expected travel over the step (it sizes the search's first trial)."""
     now = step.now
-    explicit = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.APART: phases.apart}
+    explicit = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.FACE: phases.face,
+                st.APART: phases.apart}
     scale = _force_scale(stepper, now)
     # Finite differences on the lift's own scale over the step: a viscous solid's force is
     # nonlinear in the lift on the scale of the rate it implies (a unit-sized difference put

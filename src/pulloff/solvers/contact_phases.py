@@ -256,4 +256,10 @@ def apart(step, H):
     return step.evaluate(0.0, 0.0, H)
 
 
-PHASES = {st.BONDED, st.PINNED, st.CONTACT_PHASE, st.ZONE, st.APART}
+def face(step, H):
+    """Flat punch, zone on the face past its strength: the zone alone holds the whole face
+    (the bond is gone, ``a = 0``, ``b`` at the rim) until the rim's gap reaches ``delta``."""
+    return step.evaluate(0.0, step.now.beta, H)
+
+
+PHASES = {st.BONDED, st.PINNED, st.CONTACT_PHASE, st.ZONE, st.FACE, st.APART}

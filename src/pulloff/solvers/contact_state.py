@@ -14,6 +14,7 @@ BONDED = "bonded"  # flat punch, zone outside: a at the rim, b from the edge con
 PINNED = "pinned"  # flat punch, zone on the face: b at the rim, a from the edge condition
 CONTACT_PHASE = "contact"  # a and b both free (a recedes, advances or sticks)
 ZONE = "zone"  # no contact, the zone alone pulls the surface (a = 0)
+FACE = "face"  # flat punch past its face's strength: a = 0, b at the rim until gap(R) = delta
 APART = "apart"  # no zone: the surfaces are further apart than delta
 DONE = "done"
 
