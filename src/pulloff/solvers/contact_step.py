@@ -85,9 +85,7 @@ class Step:
             K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G, K.S_FRESH]] = (
             now.t, dt, now.alpha, now.beta, stepper.nodes.xi_max, law.kappa_inf, law.c, law.d,
             1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n, 1.0 if self.fresh else 0.0)
-        # A flat punch's first bond edge: inside it the elements were bonded, beyond it
-        # loaded by the zone, and their displacement has a kink there.
-        sc[K.S_KINK] = (stepper.rows[0][2] if stepper.rows else now.alpha) if setup.flat else 0.0
+        sc[K.S_KINK] = stepper.first_edge
         self._constants = sc
 
     @property

@@ -67,6 +67,9 @@ class Stepper:
         self.phase_row = 0  # the row where the current phase began
         self.segment = 0
         self.last_dt = None
+        # A flat punch's first bond edge: inside it the elements were bonded, beyond it
+        # loaded by the zone, and their displacement has a kink there (0: none).
+        self.first_edge = 0.0
         # The ranges the lift and the force are measured in (grow with what is seen).
         self.H_range = max([1.0, abs(setup.h0)] + [abs(d.end[1]) for d in setup.drives
                                                     if d.end[0] == "lift"]
@@ -110,6 +113,7 @@ class Stepper:
             alpha, beta, phase = 0.0, 0.0, st.APART
             self.nodes.insert(0.0, t_last=0.0)
         now = st.Instant(0.0, H0, Hdot, alpha, beta, phase, Hf=Hf)
+        self.first_edge = alpha if s.flat else 0.0
         ev = Step(self, now, 1e-300, None).evaluate(alpha, beta, H0) if phase != st.APART \
             else None
         if ev is not None:
@@ -269,47 +273,47 @@ class Stepper:
         self.commit(step, ev)
         self.transition(event)
 
+    def _last_quadratic(self, column, power=1):
+        """``(t2, c, shrank)``: the quadratic ``c`` (in ``t - t2``) through the last three rows
+        of this phase where row ``column`` is positive, of that column to the ``power``, and
+        whether it fell over the last of them; None without three such rows at distinct
+        times. Scanned from the end: it runs every step."""
+        picked = []
+        for k in range(len(self.rows) - 1, self.phase_row - 1, -1):
+            if self.rows[k][column] > 0.0:
+                picked.append(self.rows[k])
+                if len(picked) == 3:
+                    break
+        if len(picked) < 3:
+            return None
+        (t2, y2), (t1, y1), (t0, y0) = [(r[0], r[column] ** power) for r in picked]
+        if not t0 < t1 < t2:
+            return None
+        return t2, np.polyfit([t0 - t2, t1 - t2, 0.0], [y0, y1, y2], 2), y2 < y1
+
     def _vanishes_within(self, dt, column, power=2):
         """The time at which an edge (row ``column``) that vanishes like
         ``(t_end - t)^(1/power)`` reaches 0 within the next ``dt``, or None. Its equation
         becomes ill-conditioned there, but its ``power`` is smooth in time: the root of the
         quadratic through its last three values in this phase is the end."""
-        rows = [r for r in self.rows[self.phase_row:] if r[column] > 0.0]
-        if len(rows) < 3:
+        fit = self._last_quadratic(column, power)
+        if fit is None or not fit[2]:
             return None
-        (t0, y0), (t1, y1), (t2, y2) = [(r[0], r[column] ** power) for r in rows[-3:]]
-        if not (t0 < t1 < t2) or y2 >= y1:
-            return None
-        c = np.polyfit([t0 - t2, t1 - t2, 0.0], [y0, y1, y2], 2)
-        roots = [r.real for r in np.roots(c) if abs(r.imag) < 1e-12 and r.real > 0.0]
+        roots = [r.real for r in np.roots(fit[1]) if abs(r.imag) < 1e-12 and r.real > 0.0]
         if not roots or min(roots) > dt:
             return None
         return self.now.t + min(roots)
 
-    def _extrapolated(self, t, column) -> float:
-        """Row ``column`` at ``t`` by the quadratic through its last three rows."""
-        rows = self.rows[-3:]
-        ts = [r[0] for r in rows]
-        if len(rows) < 3 or not ts[0] < ts[1] < ts[2]:
-            return math.inf
-        c = np.polyfit(np.array(ts) - ts[2], [r[column] for r in rows], 2)
-        return float(np.polyval(c, t - ts[2]))
-
-    def _lift_at(self, t, F_total) -> float:
-        """The lift at ``t`` (after now) carrying ``F_total``: driven, or where the machine's
-        spring holds that force."""
-        now = self.now
-        if self.setup.machine is not None:
-            driver = now.driver + self._driver_rate() * (t - now.t)
-            return driver - F_total / self.setup.machine
-        return now.H + (t - now.t) * (self.drive.rate if self.lift_driven
-                                       and self.drive.kind == "speed" else now.Hdot)
-
     def _land(self, t_end, what, **values) -> None:
-        """End the phase at ``t_end`` with the state ``values`` (a vanishing edge's limit)."""
+        """End the phase at ``t_end`` with the state ``values`` (a vanishing edge's limit): the
+        lift driven, or where the machine's spring holds their force."""
         now = self.now
-        H = self._lift_at(t_end, values["F_total"])
         driver = now.driver + self._driver_rate() * (t_end - now.t)
+        if self.setup.machine is not None:
+            H = driver - values["F_total"] / self.setup.machine
+        else:
+            H = now.H + (t_end - now.t) * (self.drive.rate if self.lift_driven
+                                            and self.drive.kind == "speed" else now.Hdot)
         self.before, self.last_dt = now, t_end - now.t
         self.now = now.copy(t=t_end, H=H, driver=driver, **values)
         self._row(self.now)
@@ -350,7 +354,10 @@ class Stepper:
             self.transition("strength")
             return True
         t_end = self._vanishes_within(4.0 * self.last_dt, 2, 3)
-        if t_end is None or self._extrapolated(t_end, 4) >= 1.0:
+        if t_end is None:
+            return False
+        rim = self._last_quadratic(4)  # the rim's gap, to check no onset comes first
+        if rim is None or np.polyval(rim[1], t_end - rim[0]) >= 1.0:
             return False
         beta = self.now.beta
         self._land(t_end, "strength", alpha=0.0, F_contact=0.0, F_total=math.pi * beta * beta)
