@@ -301,8 +301,39 @@ def test_free_gap_integral_extrapolates_the_end_value_from_beyond_a_kink():
     th = np.arccos(xi / beta)
     U = np.where(xi > kink, 1.0 + 2.0 * th, 2.2 + 0.3 * (th - math.acos(kink / beta)) ** 2)
     n = xi.size
-    given_end = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], 1.0)
+    given_end = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], 1.0, kink)
     beyond = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan, kink)
     across = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan)
     assert beyond == pytest.approx(given_end, rel=1e-13)
     assert abs(across - given_end) > 1e-4 * abs(given_end)
+
+
+def test_free_gap_integral_keeps_its_fourth_order_across_a_kink():
+    """With the kink known no stencil crosses it: each side is integrated to the kink with
+    the value there extrapolated from its own nodes, and the error falls at fourth order in
+    the spacing (measured ratios 19 and 18 per halving); a stencil across it is second order
+    (ratio ~4) and far larger."""
+    from pulloff.kernels import contact as C
+
+    beta, kink = 1.2, 1.0
+    th_k = math.acos(kink / beta)
+
+    def field(th):
+        return np.where(th < th_k, 1.0 + np.sin(2.0 * th), 1.0 + math.sin(2.0 * th_k)
+                        + 0.3 * (th - th_k) + np.cos(th) - math.cos(th_k))
+
+    exact = (th_k - 0.5 * math.cos(2.0 * th_k) + 0.5) + (
+        (1.0 + math.sin(2.0 * th_k) - math.cos(th_k)) * (0.5 * math.pi - th_k)
+        + 0.15 * (0.5 * math.pi - th_k) ** 2 + 1.0 - math.sin(th_k))
+    errors = {}
+    for nodes in (24, 48, 96):
+        th = (np.arange(nodes) + 0.37) * (0.5 * math.pi / nodes)  # no node on the kink
+        xi = np.sort(beta * np.cos(th))
+        U = field(np.arccos(xi / beta))
+        args = (xi, U, 0, nodes, 0.0, beta, float(field(0.5 * math.pi)), float(field(0.0)))
+        errors[nodes] = (abs(C.free_gap_integral(*args, kink) - exact),
+                         abs(C.free_gap_integral(*args) - exact))
+    split = [errors[n][0] for n in (24, 48, 96)]
+    across = [errors[n][1] for n in (24, 48, 96)]
+    assert split[0] / split[1] > 10.0 and split[1] / split[2] > 10.0, errors
+    assert across[-1] > 100.0 * split[-1], errors

@@ -497,7 +497,8 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta, kink=0.0):
     ``xi = beta cos(theta)``: the piecewise cubic through the nodes strictly inside, ``U_alpha``
     at the contact edge and ``U_beta`` at the zone end (nan: extrapolated from the nodes next to
     it, where ``U`` is smooth in ``theta``; only from those beyond ``kink``, where ``U`` has a
-    kink inside the zone and at least two nodes lie between it and the end)."""
+    kink inside the zone and at least two nodes lie between it and the end). With two nodes or
+    more on each side of the kink no stencil crosses it (:func:`_split_integral`)."""
     n_in = 0
     for i in range(lo, hi):
         if alpha < xi[i] < beta:
@@ -524,20 +525,43 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta, kink=0.0):
     th[k] = th[m - 1]
     f[k] = f[m - 1]
     m = k + 1
+    # The nodes are in ascending theta: those beyond the kink come first.
+    th_kink = angle(kink, beta) if alpha < kink < beta else math.nan
+    beyond = 0  # interior nodes beyond the kink
+    while beyond < m - 2 and th[beyond + 1] < th_kink:
+        beyond += 1
     if math.isnan(U_beta):
-        usable = m - 1
-        if 0.0 < kink < beta:
-            # The nodes are in ascending theta: those beyond the kink come first.
-            th_kink = angle(kink, beta)
-            smooth = 0
-            while smooth < m - 2 and th[smooth + 1] < th_kink:
-                smooth += 1
-            if smooth >= 2:
-                usable = smooth
+        usable = beyond if beyond >= 2 else m - 1
         f[0] = extrapolate_cubic(th[1:], f[1:], usable, 0.0)
     else:
         f[0] = U_beta
+    if beyond >= 2 and m - 2 - beyond >= 2:
+        return _split_integral(th, f, m, beyond + 1, th_kink)
     return piecewise_cubic_integral(th, f, m)
+
+
+@njit(cache=True)
+def _split_integral(th, f, m, s, th_kink):
+    """The piecewise cubic integral of ``f(th)`` with no stencil across ``th_kink``, between
+    nodes ``s - 1`` and ``s``, where ``f`` is continuous but its slope jumps (a stencil across
+    it is only second order in the spacing): each side runs to the kink with the value there
+    extrapolated from its own nodes."""
+    left_th = np.empty(s + 1)
+    left_f = np.empty(s + 1)
+    left_th[:s] = th[:s]
+    left_f[:s] = f[:s]
+    right_th = np.empty(m - s + 1)
+    right_f = np.empty(m - s + 1)
+    right_th[1:] = th[s:m]
+    right_f[1:] = f[s:m]
+    near_th = left_th[:s][::-1].copy()  # nearest the kink first
+    near_f = left_f[:s][::-1].copy()
+    left_th[s] = th_kink
+    left_f[s] = extrapolate_cubic(near_th, near_f, s, th_kink)
+    right_th[0] = th_kink
+    right_f[0] = extrapolate_cubic(right_th[1:], right_f[1:], m - s, th_kink)
+    return (piecewise_cubic_integral(left_th, left_f, s + 1)
+            + piecewise_cubic_integral(right_th, right_f, m - s + 1))
 
 
 # --- one trial step, compiled ------------------------------------------------------------------
