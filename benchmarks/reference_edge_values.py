@@ -83,6 +83,10 @@ def scenes():
     out["finite_punch_spring_kv"] = dict(G_inf=1e6, eta=1e3, arms=(), sigma_c=1e6, delta=3e-6,
                                          R=1e-5, v=1e-3, h0=0.0, zone="internal",
                                          machine_stiffness=1e3)
+    # Past the onset behind springs: a Kelvin-Voigt bond behind a soft one (it snaps where
+    # a reaches 0), a standard linear solid's finite punch behind 100 N/m (its zone folds).
+    out["compliant_machine_k10"] = dict(out["compliant_machine"], machine_stiffness=10.0)
+    out["sls_finite_punch_spring"] = dict(out["sls_finite_punch"], machine_stiffness=100.0)
     return out
 
 

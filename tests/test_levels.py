@@ -117,6 +117,16 @@ def test_an_event_missing_on_a_coarse_level_is_not_converged():
     assert estimate == math.inf
 
 
+def test_an_output_missing_on_the_coarsest_of_three_levels_is_not_converged():
+    """The contact solver's three-level estimates: a separation found on the two finer levels
+    only (the coarsest stopped at a crack arrest) once dropped out of the comparison, and the
+    estimate came from the other outputs alone."""
+    nan = math.nan
+    values = [np.array([1.0, nan]), np.array([1.001, 2.0]), np.array([1.00025, 2.1])]
+    assert levels.richardson(values, ORDER)[0] == math.inf
+    assert levels.extrapolate_measured(values, ORDER)[1] == math.inf
+
+
 def test_extrapolations_that_stop_changing_keep_the_previous_change_as_estimate():
     """Extrapolations off by 1.3e-6, then 0 and 0 (a change of exactly 0): the guard from
     the change before still holds (the review found an estimate of 0 here)."""

@@ -53,11 +53,13 @@ def richardson(values: Sequence[np.ndarray], order: Order, floor=None) -> tuple[
     For the output that changed most between the last two levels: its last difference divided
     by ``2^p - 1``, ``p`` measured from the three levels and clipped to ``order``. Below a
     measured order of 0.5 the levels are not converging and the estimate is the larger of the
-    last two differences, with no extrapolation. An event found on one level only gives
-    ``inf``. Differences are relative to :func:`_scale`.
+    last two differences, with no extrapolation. An event found on some of the three levels
+    only gives ``inf`` (once only the last two were compared: an output missing on the
+    coarsest level dropped out of the estimate unseen). Differences are relative to :func:`_scale`.
     """
     v0, v1, v2 = (np.asarray(v, dtype=float) for v in values)
-    if not np.array_equal(np.isnan(v1), np.isnan(v2)):
+    if not (np.array_equal(np.isnan(v1), np.isnan(v2))
+            and np.array_equal(np.isnan(v0), np.isnan(v2))):
         return math.inf, math.nan
     scale = _scale(v2, floor)
     mask = np.isfinite(v2) & (scale != 0) & np.isfinite(v1) & np.isfinite(v0)
