@@ -56,6 +56,20 @@ class ContactSolver(Solver):
                 "material.kind", scene.material.kind, f"a {scene.geometry.kind} on a "
                 "Kelvin-Voigt solid is not solved (its jump into contact has no instantaneous "
                 "response); use a standard linear solid with a stiff, fast arm"))
+        machine = getattr(scene.loading, "machine_stiffness", None)
+        if (machine is not None and scene.model.until == "separation"
+                and scene.material.spectrum().arms
+                and getattr(scene.geometry, "cohesive_zone", "") == "external"):
+            # Measured (standard linear solid, tau 0.1 ms, behind 1e4 N/m): after the contact
+            # is lost the zone alone ends at first order, t_separation 2.4 % and 1.1 % apart
+            # at n = 16, 32, 64, and the moving-edge reference loses its force balance there.
+            # On the face (internal zone) the same solid matches the reference.
+            out.append(problem_line(
+                "loading.machine_stiffness", machine, "past the onset, a solid with Maxwell "
+                "arms behind a machine spring with the zone outside the punch is not solved "
+                "reliably yet (first-order convergence, no second method); run it to the "
+                "onset (model.until: detach), with a rigid machine, or with the zone on the "
+                "face"))
         if scene.model.history != "exact":
             out.append(problem_line(
                 "model.history", scene.model.history, "the seed's frozen load history (eq. 31) "

@@ -64,6 +64,7 @@ class Stepper:
         self.events = []  # (t, name)
         self.notes = []  # (what, t): why a run stopped early
         self.kinks = set()  # rows at events: the history may have a corner there
+        self.bisecting = False  # bisecting toward a branch's end (balance.solve is brief)
         self.phase_row = 0  # the row where the current phase began
         self.segment = 0
         self.last_dt = None
@@ -580,6 +581,21 @@ class Stepper:
                     self.commit(*found)
                 self.transition(what)
                 return
+        self.bisecting = True
+        try:
+            best, lo = self._longest_step(dt, what)
+        finally:
+            self.bisecting = False
+        if best is None:
+            self.transition(what)
+            return
+        self.commit(*best)
+        if self._at_limit(what) or lo <= 1e-10 * self.t_scale:
+            self.transition(what)  # the natural end, or only a vanishing step still works
+
+    def _longest_step(self, dt, what):
+        """``((step, evaluation), length)`` of the longest step up to ``dt`` whose state
+        exists and crosses no event (bisection to 1e-14 of the time), ``(None, 0)`` if none."""
         lo, hi = 0.0, dt
         best = None
         for _ in range(100):
@@ -596,12 +612,7 @@ class Stepper:
             lo, best = mid, (step, ev)
             if self._at_limit(what, ev) or hi - lo <= 1e-14 * max(self.now.t + hi, 1.0):
                 break
-        if best is None:
-            self.transition(what)
-            return
-        self.commit(*best)
-        if self._at_limit(what) or lo <= 1e-10 * self.t_scale:
-            self.transition(what)  # the natural end, or only a vanishing step still works
+        return best, lo
 
     def _at_limit(self, what, now=None) -> bool:
         """Whether the state (now, or an evaluation) is at the natural end of its branch: the
