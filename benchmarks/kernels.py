@@ -7,7 +7,9 @@ warm time per element (ns per element-step, or per table entry for the weight ta
 1e2 .. 1e5 elements, as the median and interquartile range over repeated samples, and the
 fitted exponent of time against size (1 means linear). Then it measures how a whole
 ``simulate`` run grows with the requested rtol and how ``run_foundation`` grows with the
-number of steps. Single thread; writes results/kernels.txt with the same text.
+number of steps, and how a level of the moving-edge (contact) stepper grows with its steps
+and elements (``--contact-only``: that section alone, to results/kernels_contact.txt).
+Single thread; writes results/kernels.txt with the same text.
 
 The arguments are those of a real run: the scene alpha = 1, chi = 1e-4 (thin zone, the
 seed's regime) with the step of a run of N steps per frozen detachment time, N = size.
@@ -38,6 +40,8 @@ MARCH_STEPS = [100, 300, 1_000, 3_000, 10_000]
 RTOLS = [10.0**-e for e in np.arange(3.0, 9.01, 0.5)]
 STEPS = [100 * 2**j for j in range(8)]  # 100 .. 12800
 SCENE = (1.0, 1e-4)  # alpha, chi
+CONTACT_CONFIGS = ("separation_kv", "sls_finite_punch")
+CONTACT_LEVELS = [16, 32, 64, 128, 256]
 MIN_REPEATS = 15  # samples per point, enough for a meaningful interquartile range
 MIN_TOTAL = 0.3  # s per point
 
@@ -333,10 +337,72 @@ def report_run_foundation(problem: Problem):
     return rows
 
 
+def contact_level(scene, n):
+    """``(seconds, steps, evaluations, element-evaluations, elements at the end)`` of one
+    warm level of the moving-edge stepper; every trial evaluation is counted by wrapping
+    :meth:`pulloff.solvers.contact_step.Step._evaluate` for the duration."""
+    from pulloff.solvers import contact, contact_step
+
+    counted = []
+    original = contact_step.Step._evaluate
+
+    def counting(self, alpha, beta, H_new):
+        ev = original(self, alpha, beta, H_new)
+        counted.append(len(ev.xi))
+        return ev
+
+    contact_step.Step._evaluate = counting
+    try:
+        start = time.perf_counter()
+        level = contact.run_level(scene, n)
+        seconds = time.perf_counter() - start
+    finally:
+        contact_step.Step._evaluate = original
+    return seconds, len(level.rows) - 1, len(counted), sum(counted), level.nodes.n
+
+
+def report_contact():
+    """Issue 10's linear-cost target for the moving-edge (contact) stepper: time against
+    element-evaluations (the kernel's work) and against steps, per level ``n``."""
+    from pulloff.io.scene_file import load_scene
+    from pulloff.solvers import contact
+
+    out("\n== moving-edge (contact) stepper: one warm level per n, to separation")
+    out(f"  {'config':<18} {'n':>5} {'steps':>6} {'evals':>7} {'elem-evals':>11} "
+        f"{'elements':>9} {'s':>8} {'ns/elem-eval':>13}")
+    for config in CONTACT_CONFIGS:
+        scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / f"{config}.yaml")
+        contact.run_level(scene, CONTACT_LEVELS[0])  # compile / warm
+        rows = [contact_level(scene, n) for n in CONTACT_LEVELS]
+        for n, (sec, steps, evals, work, elements) in zip(CONTACT_LEVELS, rows):
+            out(f"  {config:<18} {n:5d} {steps:6d} {evals:7d} {work:11.3g} {elements:9d} "
+                f"{sec:8.3f} {1e9 * sec / work:13.0f}")
+        secs = [r[0] for r in rows]
+        steps = [r[1] for r in rows]
+        p_work = loglog_slope([r[3] for r in rows], secs)
+        p_steps = loglog_slope(steps, secs)
+        p_top = loglog_slope(steps[-2:], secs[-2:])
+        p_elements = loglog_slope(steps, [r[4] for r in rows])
+        out(f"  {config}: time ~ element-evaluations^{p_work:.2f}; ~ steps^{p_steps:.2f} over "
+            f"all, ^{p_top:.2f} over the top two; elements ~ steps^{p_elements:.2f} (the "
+            f"target: time ~ steps^1, elements bounded)")
+
+
 def main() -> None:
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--contact-only", action="store_true",
+                        help="only the moving-edge stepper's section (results/kernels_contact.txt)")
+    args = parser.parse_args()
     wall_start = time.perf_counter()
     RESULTS.mkdir(exist_ok=True)
     out(machine_summary())
+    if args.contact_only:
+        report_contact()
+        out(f"\ntotal run time {time.perf_counter() - wall_start:.0f} s")
+        (RESULTS / "kernels_contact.txt").write_text("\n".join(_lines) + "\n")
+        return
     problem = Problem.from_scene(scene_for_groups(*SCENE))
     out(f"scene alpha = {SCENE[0]:g}, chi = {SCENE[1]:g}: k = {problem.k:.4g}, c = "
         f"{problem.c:.4g} (dimensionless, units of solvers/problem.py)\n")
@@ -344,6 +410,7 @@ def main() -> None:
     report_march(problem)
     report_simulate(*SCENE)
     report_run_foundation(problem)
+    report_contact()
     out(f"\ntotal run time {time.perf_counter() - wall_start:.0f} s")
     (RESULTS / "kernels.txt").write_text("\n".join(_lines) + "\n")
 
