@@ -311,8 +311,9 @@ def test_free_gap_integral_extrapolates_the_end_value_from_beyond_a_kink():
 def test_free_gap_integral_keeps_its_fourth_order_across_a_kink():
     """With the kink known no stencil crosses it: each side is integrated to the kink with
     the value there extrapolated from its own nodes, and the error falls at fourth order in
-    the spacing (measured ratios 19 and 18 per halving); a stencil across it is second order
-    (ratio ~4) and far larger."""
+    the spacing (measured ratios 15-26 per halving at 48..192 nodes, wherever the nodes sit
+    against the kink); a stencil across it converges irregularly at about second order and
+    is 400-8000x larger at 192 nodes."""
     from pulloff.kernels import contact as C
 
     beta, kink = 1.2, 1.0
@@ -325,15 +326,14 @@ def test_free_gap_integral_keeps_its_fourth_order_across_a_kink():
     exact = (th_k - 0.5 * math.cos(2.0 * th_k) + 0.5) + (
         (1.0 + math.sin(2.0 * th_k) - math.cos(th_k)) * (0.5 * math.pi - th_k)
         + 0.15 * (0.5 * math.pi - th_k) ** 2 + 1.0 - math.sin(th_k))
-    errors = {}
-    for nodes in (24, 48, 96):
-        th = (np.arange(nodes) + 0.37) * (0.5 * math.pi / nodes)  # no node on the kink
-        xi = np.sort(beta * np.cos(th))
-        U = field(np.arccos(xi / beta))
-        args = (xi, U, 0, nodes, 0.0, beta, float(field(0.5 * math.pi)), float(field(0.0)))
-        errors[nodes] = (abs(C.free_gap_integral(*args, kink) - exact),
-                         abs(C.free_gap_integral(*args) - exact))
-    split = [errors[n][0] for n in (24, 48, 96)]
-    across = [errors[n][1] for n in (24, 48, 96)]
-    assert split[0] / split[1] > 10.0 and split[1] / split[2] > 10.0, errors
-    assert across[-1] > 100.0 * split[-1], errors
+    for offset in (0.1, 0.37, 0.9):  # no node on the kink
+        split, across = [], []
+        for nodes in (48, 96, 192):
+            th = (np.arange(nodes) + offset) * (0.5 * math.pi / nodes)
+            xi = np.sort(beta * np.cos(th))
+            U = field(np.arccos(xi / beta))
+            args = (xi, U, 0, nodes, 0.0, beta, float(field(0.5 * math.pi)), float(field(0.0)))
+            split.append(abs(C.free_gap_integral(*args, kink) - exact))
+            across.append(abs(C.free_gap_integral(*args) - exact))
+        assert split[0] / split[1] > 10.0 and split[1] / split[2] > 10.0, (offset, split)
+        assert across[-1] > 100.0 * split[-1], (offset, split, across)

@@ -125,6 +125,9 @@ def test_an_output_missing_on_the_coarsest_of_three_levels_is_not_converged():
     values = [np.array([1.0, nan]), np.array([1.001, 2.0]), np.array([1.00025, 2.1])]
     assert levels.richardson(values, ORDER)[0] == math.inf
     assert levels.extrapolate_measured(values, ORDER)[1] == math.inf
+    # Even where the two finer levels agree bitwise.
+    same = [np.array([1.0, nan]), np.array([1.0, 2.0]), np.array([1.0, 2.0])]
+    assert levels.extrapolate_measured(same, ORDER)[1] == math.inf
 
 
 def test_extrapolations_that_stop_changing_keep_the_previous_change_as_estimate():

@@ -11,16 +11,16 @@ doubling. Measured (relative errors at n = 8, 16, 32; order):
 scene, output                     errors                          order
 ================================  ==============================  =====
 separation_kv, onset time         5.7e-7, 6.3e-8, 3.2e-9          3.74
-separation_kv, separation time    1.7e-4, 2.3e-5, 2.4e-6          3.07
-separation_kv, peak force         1.2e-4, 1.8e-5, 2.5e-6          2.79
+separation_kv, separation time    1.7e-4, 2.3e-5, 2.5e-6          3.06
+separation_kv, peak force         1.2e-4, 1.8e-5, 2.5e-6          2.78
 finite_punch_internal, onset      2.4e-6, 4.9e-7, 3.7e-8          3.01
-finite_punch_internal, separation 6.9e-4, 1.8e-4, 4.8e-5          1.93
+finite_punch_internal, separation 6.9e-4, 1.7e-4, 4.7e-5          1.93
 finite_punch_internal, peak       5.3e-4, 9.8e-5, 1.3e-5          2.65
 sls_finite_punch, onset           6.6e-9, 1.8e-9, 1.3e-10         2.83
-sls_finite_punch, separation      3.4e-4, 2.9e-5, 2.7e-6          3.48
+sls_finite_punch, separation      3.4e-4, 2.9e-5, 3.0e-6          3.41
 sls_finite_punch, peak            8.8e-5, 5.9e-6, 1.2e-6          3.07
 sls external at 1e-2 m/s, onset   1.5e-6, 1.9e-7, 2.4e-8          2.99
-sls external, separation          3.0e-5, 2.7e-6, 3.3e-7          3.26
+sls external, separation          6.4e-5, 6.5e-6, 1.0e-6          2.97
 sls external, peak                (the onset: it comes off there) 2.99
 ================================  ==============================  =====
 

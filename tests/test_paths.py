@@ -134,6 +134,18 @@ def test_flat_punch_through_a_path_gives_the_pull_numbers():
     assert path.F_pulloff == pytest.approx(pull.F_peak_total, rel=1e-3)
 
 
+def test_force_controlled_kelvin_voigt_punch_still_comes_off():
+    """Under a driven force (no machine spring) a lost balance is the load-controlled
+    pull-off, not the crack arrest of a Kelvin-Voigt bond behind a spring (the review found
+    the arrest stopping this run at a = 0.42 R with no separation)."""
+    scene = load_scene(CONFIGS / "separation_kv.yaml", overrides=[
+        "loading={kind: path, control: force, h0: 0.0, "
+        "segments: [{force_rate: 0.1, until: separation}]}"])
+    level = contact.run_level(scene, 16)
+    assert [name for _, name in level.events][-3:] == ["balance", "jump_out", "separated"]
+    assert not level.notes and level.summary["F_jump_out"] > 0.0
+
+
 @pytest.mark.parametrize("lam", [0.1, 0.3])
 def test_dmt_like_sphere_matches_maugis_dugdale_and_tends_to_dmt(lam):
     """Small lambda: the zone is born stable and grows (no jump in), the contact is lost

@@ -295,6 +295,31 @@ def test_compliant_machine_separation_converges_to_the_reference():
     assert level.summary["F_peak_total"] == pytest.approx(ref["F_peak_total"], rel=6e-5)
 
 
+def test_a_bond_landed_on_its_end_without_a_zone_state_lets_its_elements_go(monkeypatch):
+    """The landing's fallback (no zone-alone state at a = 0: the punch lets go there) frees
+    the bond's elements before it moves the clock (the review found them left in contact).
+    Forced here by refusing every zone-alone step; the separation time is that of the
+    landing the solver takes anyway (the zone alone cannot hold behind 100 N/m)."""
+    from pulloff.solvers import contact_phases, contact_state, contact_stepper
+
+    scene = load_scene(CONFIGS / "compliant_machine.yaml", overrides=["model.until=separation"])
+    free = contact.run_level(scene, 32)
+    solve = contact_stepper.Stepper.solve
+
+    def no_zone_alone(self, step):
+        if self.now.phase == contact_state.ZONE:
+            raise contact_phases.Lost("balance")
+        return solve(self, step)
+
+    monkeypatch.setattr(contact_stepper.Stepper, "solve", no_zone_alone)
+    forced = contact.run_level(scene, 32)
+    assert [name for _, name in forced.events] == ["onset", "contact", "balance", "separated"]
+    nodes = forced.nodes
+    assert not np.any(nodes.status[:nodes.n] == contact_state.CONTACT)
+    assert forced.summary["t_separation"] == pytest.approx(free.summary["t_separation"],
+                                                           rel=1e-9)
+
+
 def test_standard_linear_solid_behind_a_spring_folds_where_the_reference_does():
     """sls_finite_punch.yaml behind 100 N/m: a solid with an instantaneous modulus may snap
     (its zone's branch folds, the reference's "fold"). Measured at n = 32: t_separation

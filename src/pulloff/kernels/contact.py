@@ -498,7 +498,10 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta, kink=0.0):
     at the contact edge and ``U_beta`` at the zone end (nan: extrapolated from the nodes next to
     it, where ``U`` is smooth in ``theta``; only from those beyond ``kink``, where ``U`` has a
     kink inside the zone and at least two nodes lie between it and the end). With two nodes or
-    more on each side of the kink no stencil crosses it (:func:`_split_integral`)."""
+    more on each side of the kink no stencil crosses it (:func:`_split_integral`); with one,
+    the side's value at the kink would be a linear extrapolation over a sparse stretch
+    (tried: separation_kv at 1e-2 m/s then jumped out spuriously at n = 128), so the cubic
+    crosses it there."""
     n_in = 0
     for i in range(lo, hi):
         if alpha < xi[i] < beta:

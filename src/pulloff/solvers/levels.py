@@ -156,6 +156,9 @@ def extrapolate_measured(values: Sequence[np.ndarray], order: Order,
     rtol 1e-6, where levels outside the asymptotic range put it 25x below.
     """
     v0, v1, v2 = (np.asarray(v, dtype=float) for v in values[-3:])
+    if not (np.array_equal(np.isnan(v0), np.isnan(v2))
+            and np.array_equal(np.isnan(v1), np.isnan(v2))):
+        return v2.copy(), math.inf  # an event found on some levels only
     _, measured = richardson(values[-3:], order, floor)
     if not math.isfinite(measured) or measured < DIVERGING_ORDER:
         same = np.array_equal(v1, v2, equal_nan=True)
