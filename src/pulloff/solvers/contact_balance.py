@@ -45,10 +45,6 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
         both = _smooth_contact(stepper, step, H_guess, H_scale, force_residual, scale)
         if both is not None:
             return both
-    if now.phase == st.ZONE and not step.jump and now.beta > 1e-9:
-        alone = _zone_alone(stepper, step, H_guess, H_scale, force_residual, scale)
-        if alone is not None:
-            return alone
     if now.phase == st.CONTACT_PHASE and stepper.setup.flat:
         held = _newton(lambda z: _with_force(_stick(step, z[0]), force_residual),
                        np.array([H_guess]), H_scale, scale)
@@ -69,53 +65,19 @@ def _smooth_contact(stepper, step, H_guess, H_scale, force_residual, scale):
     if alpha_guess <= 0.0:
         return None
 
-    out = _unknown_and_lift(
-        lambda alpha, H: step.evaluate(alpha, phases.edge_zone(step, H, alpha), H), "contact",
-        alpha_guess, now.alpha, H_guess, H_scale, force_residual, scale)
+    def residual(z):
+        alpha, H = z
+        if alpha <= 0.0:
+            raise phases.Lost("contact")
+        ev = step.evaluate(alpha, phases.edge_zone(step, H, alpha), H)
+        return ev, np.array([ev.gap - 1.0, force_residual(ev)])
+
+    alpha_scale = max(abs(alpha_guess - now.alpha), 1e-6 * now.alpha, 1e-12)
+    out = _newton(residual, np.array([alpha_guess, H_guess]),
+                  np.array([alpha_scale, H_scale[0]]), np.array([1.0, scale[0]]))
     if out is None or abs(out[0].alpha - now.alpha) > 0.25 * max(now.alpha, 1.0):
         return None  # no state, or one on another branch
     return out[0]
-
-
-def _zone_alone(stepper, step, H_guess, H_scale, force_residual, scale):
-    """The zone alone: Newton on the zone end and the lift together (``gap(b) = delta`` and
-    the force balance), from the predictor; None where it does not converge or lands off the
-    branch (the zone end moved by more than a quarter, a flat punch's zone grew, the solid
-    would pass through the indenter), and the nested search takes over. The nested search
-    took ~60 evaluations a step on a standard linear solid's zone behind a spring."""
-    now = step.now
-    beta_guess = stepper.guesses(step)[1]
-    if beta_guess <= 0.0:
-        return None
-
-    out = _unknown_and_lift(lambda beta, H: step.evaluate(0.0, beta, H), "zone", beta_guess,
-                            now.beta, H_guess, H_scale, force_residual, scale)
-    if out is None:
-        return None
-    ev = out[0]
-    if (abs(ev.beta - now.beta) > 0.25 * now.beta
-            or (stepper.setup.flat and ev.beta > now.beta * (1.0 + 1e-12))
-            or ev.H - ev.centre_u < -1e-9 * max(abs(ev.H), 1.0)):
-        return None
-    return ev
-
-
-def _unknown_and_lift(evaluate, branch, guess, current, H_guess, H_scale, force_residual,
-                      scale):
-    """Newton on the phase's unknown (an edge, positive; ``evaluate(x, H)``) and the lift
-    together: ``gap(b) = delta`` and the force balance. The unknown's finite differences are
-    sized by its predicted move. ``(evaluation, residuals)``, or None."""
-
-    def residual(z):
-        x, H = z
-        if x <= 0.0:
-            raise phases.Lost(branch)
-        ev = evaluate(x, H)
-        return ev, np.array([ev.gap - 1.0, force_residual(ev)])
-
-    x_scale = max(abs(guess - current), 1e-6 * current, 1e-12)
-    return _newton(residual, np.array([guess, H_guess]), np.array([x_scale, H_scale[0]]),
-                   np.array([1.0, scale[0]]))
 
 
 def _with_force(ev, force_residual):
