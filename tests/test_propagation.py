@@ -158,6 +158,19 @@ def test_finite_punch_force_never_exceeds_the_strength_limit():
     assert res.F_total_detach > elastic["F_total"]
 
 
+def test_a_face_held_at_its_strength_limit_peaks_at_that_limit():
+    """sls_finite_punch.yaml pulled at 0.72 m/s (the rate sweep's 48th speed) reaches the
+    strength limit and the face holds there: the peak is the limit. The parabola that
+    refines a smooth maximum was once fitted through the limit's row and the next (1 ulp
+    lower, 1e-15 later) and put the n = 64 level's peak 4.2e-6 above it (the reported one
+    5.5e-6)."""
+    scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
+                       overrides=["loading.v=0.7196856730011514"])  # of the rate sweep
+    limit = math.pi * 1e-5 ** 2 * 1e7
+    assert contact.run_level(scene, 64).summary["F_peak_total"] <= limit * (1 + 1e-12)
+    assert solvers.simulate(scene).F_peak_total <= limit * (1 + 1e-12)
+
+
 def test_elastic_internal_closed_form_limits():
     G, sigma_c, R = 1e6, 1e7, 1e-5
     # Thin zone: the bond covers the face and the force tends to Kendall's.
