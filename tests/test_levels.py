@@ -106,6 +106,29 @@ def test_property_with_a_fifth_order_term_the_estimate_stays_within_ten_times(a,
     assert estimate >= true / 10.0 - 1e-14, (estimate, true)
 
 
+def test_levels_that_do_not_converge_regularly_give_their_largest_change_as_estimate():
+    """A Prony punch behind a spring: separation times 8.2e-6 then 6.9e-6 apart (measured
+    order 0.25). The estimate is the larger change, not infinite (which refined that run to
+    n = 128 at rtol 1e-2, three times the work), and the finest level is reported as is."""
+    values = [np.array([5.456121e-3]), np.array([5.456166e-3]), np.array([5.456128e-3])]
+    e, estimate = levels.extrapolate_measured(values, ORDER)
+    assert e[0] == values[-1][0]
+    assert estimate == abs(values[1][0] - values[0][0]) / values[-1][0]
+
+
+@settings(max_examples=200, deadline=None)
+@given(p=st.floats(0.2, 0.5, exclude_max=True), c=st.floats(-1.0, 1.0).filter(
+    lambda x: abs(x) > 1e-6), log_h=st.floats(-6, -1))
+def test_property_slowly_converging_levels_keep_an_estimate_within_ten_times(p, c, log_h):
+    """Levels converging at an order below the diverging one (0.5), ``1 + c h^p``: the estimate
+    falls below the finest level's error by at most ``1/(2^p (2^p - 1))`` (5.8x at p = 0.2),
+    within issue 10's 10x."""
+    values = ladder({p: c}, 10.0**log_h, 3)
+    e, estimate = levels.extrapolate_measured(values, ORDER)
+    true = abs(e[0] - 1.0)
+    assert true / 10.0 <= estimate <= 10.0 * true
+
+
 def test_an_event_missing_on_a_coarse_level_is_not_converged():
     """A level that ran out of time (t_max just past the event) has nan where the others
     detach: the estimate is infinite, not 0 from an empty comparison (the review found the

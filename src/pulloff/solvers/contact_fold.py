@@ -1,6 +1,7 @@
-"""Where a smooth indenter's branch folds inside a step: the jump out of contact (the edge's
-branch ends), the jump into it (a growing zone's branch ends), and a force-controlled pull-off
-(the force the branch can carry is passed), MODEL.md section 9.
+"""Where a branch folds inside a step: a smooth indenter's jump out of contact (the edge's
+branch ends), the jump into it (a growing zone's branch ends), a force-controlled pull-off
+(the force the branch can carry is passed), MODEL.md section 9, and a flat punch's balance
+lost behind a spring.
 
 At a fold the state's unknown ``x`` (the edge ``alpha`` in contact, the zone end ``beta`` in the
 zone alone) stops being a function of the step length ``d``; but ``d`` stays a smooth function
@@ -33,10 +34,15 @@ NOW = "now"
 
 def foldable(stepper, what) -> bool:
     """Whether a lost branch is one this module locates: a smooth indenter's contact or zone
-    alone."""
+    alone, and a flat punch's receding edge or zone alone behind a machine spring or under
+    force control (its balance lost: the force the branch carries has a maximum). Behind a
+    spring the flat branch's end was bisected before: each failed probe ran a full nested
+    search for a lift that is not there (1500-2000 evaluations), and the standard linear solid
+    behind 100 N/m took 30415 evaluations at n = 32 against 6014 located."""
     phase = stepper.now.phase
-    return (not stepper.setup.flat and what in ("contact", "zone", "balance")
-            and phase in (st.CONTACT_PHASE, st.ZONE))
+    if stepper.setup.flat:
+        return what == "balance" and phase in (st.CONTACT_PHASE, st.ZONE)
+    return what in ("contact", "zone", "balance") and phase in (st.CONTACT_PHASE, st.ZONE)
 
 
 def locate(stepper, dt, what):

@@ -18,18 +18,30 @@ from .contact_step import quadratic_path
 #: The fewest elements strictly inside the zone before new ones are replayed into it.
 MIN_INSIDE = 8
 #: Phases whose zone grows into virgin solid (elements gather in it) and may be thinned: the
-#: bonded punch's, and only on an elastic solid, whose elements hold no state (without it an
-#: elastic punch finds a spurious branch past its onset among the crowded elements). On a
-#: solid with memory thinning cost accuracy: a standard linear solid's onset scattered by
-#: 6e-3 between levels (22.45, 22.52, 22.37, 22.47 s at n = 16..128; 2e-5 without), and
-#: behind a machine spring the bonded gap jumped from 0.71 to 6.3 delta in one step. Not the
-#: receding phases: a zone end that later recedes over a thinned region integrates its last
-#: intervals too coarsely (errors ~1e-6 in the separation time were measured).
+#: bonded punch's. Not the receding phases: a zone end that later recedes over a region
+#: thinned there integrates its last intervals too coarsely (errors ~1e-6 in the separation
+#: time were measured).
 GROWING = (st.BONDED,)
-#: A thinned zone keeps this many times ``per_zone`` elements across its angle.
-THIN_FACTOR = 8.0
 
 
+def thin_factor(law) -> float | None:
+    """A thinned zone keeps this many times ``per_zone`` elements across its angle; None: never
+    thinned.
+
+    * elastic (elements hold no state): 8; without thinning an elastic punch finds a
+      spurious branch past its onset among the crowded elements;
+    * Kelvin-Voigt: 32. Measured on separation_kv at n = 64..512 against the reference: the
+      onset's errors as without thinning (t_detach 9.1e-10, 2.2e-10, 6.0e-11, 1.7e-12 without,
+      8.9e-10, 2.8e-10, 5.8e-11, -3.3e-12 with), the separation's within 2.1x of them, and
+      2.4x (n = 256) to 3.1x (n = 512) faster; at 16 or 8 the onset stalled at 3e-10 or 1e-8
+      and lost its order;
+    * Maxwell arms: none. At 32 a standard linear solid's onset stalled at ~5e-9 with
+      irregular signs (sls_external_v1e-2, n = 64..256; 3e-9, 4e-10, 5e-11 unthinned), and
+      at 8 it once scattered by 6e-3 between levels.
+    """
+    if law.maxwell:
+        return None
+    return 8.0 if _stateless(law) else 32.0
 def _paths(rows, kinks, k, column):
     """The quadratic (or, after an event, linear) path of one column over step ``k``."""
     t0, t1 = rows[k - 1][0], rows[k][0]
@@ -146,25 +158,26 @@ def refine(stepper) -> int:
 
 
 def thin(stepper) -> int:
-    """Remove free elements deep inside a crowded zone, keeping at least ``2 per_zone`` of
-    them across its angle ``theta = acos(x/b)`` (the gap's variable, where the field is smooth
-    away from the zone end) and every element nearer the end than that spacing; returns how
-    many went. A later zone that finds the region sparse replays elements back into it."""
+    """Remove free elements deep inside a crowded zone, keeping at least ``2 thin_factor
+    per_zone`` of them across its angle ``theta = acos(x/b)`` (the gap's variable, where the
+    field is smooth away from the zone end) and every element nearer the end than that
+    spacing; returns how many went. A later zone that finds the region sparse replays elements back into it."""
     now = stepper.now
     nodes = stepper.nodes
+    factor = thin_factor(stepper.setup.law)
     if (now.beta <= 0.0 or now.beta <= now.alpha or now.phase not in GROWING
-            or not _stateless(stepper.setup.law)):
+            or factor is None):
         return 0
     lo, hi = nodes.below(now.alpha), nodes.below(now.beta)
     idx = np.arange(lo, hi)
     idx = idx[(nodes.status[lo:hi] == st.FREE) & (nodes.xi[lo:hi] > now.alpha)
               & (nodes.xi[lo:hi] < now.beta)]
-    budget = int(2 * THIN_FACTOR * stepper.per_zone)
+    budget = int(2 * factor * stepper.per_zone)
     if idx.size <= budget:
         return 0
     theta_zone = math.atan2(math.sqrt((now.beta - now.alpha) * (now.beta + now.alpha)),
                             now.alpha) if now.alpha > 0.0 else 0.5 * math.pi
-    spacing = theta_zone / (THIN_FACTOR * stepper.per_zone)
+    spacing = theta_zone / (factor * stepper.per_zone)
     theta = np.array([K.angle(x, now.beta) for x in nodes.xi[idx]])
     order = np.argsort(theta)
     drop, last = [], -math.inf
