@@ -337,3 +337,28 @@ def test_free_gap_integral_keeps_its_fourth_order_across_a_kink():
             across.append(abs(C.free_gap_integral(*args) - exact))
         assert split[0] / split[1] > 10.0 and split[1] / split[2] > 10.0, (offset, split)
         assert across[-1] > 100.0 * split[-1], (offset, split, across)
+
+
+@settings(max_examples=100, deadline=None)
+@given(old=st.lists(st.floats(0.0, 2.0), max_size=40, unique=True),
+       new=st.lists(st.floats(0.0, 2.0), min_size=1, max_size=12, unique=True))
+def test_property_a_batch_of_new_elements_lands_as_one_by_one_inserts_would(old, new):
+    """contact_state.Nodes.insert_many (one merge per step) against insert (one shift per
+    element): the same sorted mesh with every column carried along."""
+    from pulloff.solvers.contact_state import CONTACT, FREE, Nodes
+
+    new = [x for x in new if x not in old] or [2.5]
+    one, batch = Nodes(2, 1, capacity=4), Nodes(2, 1, capacity=4)
+    for k, x in enumerate(sorted(old)):
+        for nodes in (one, batch):
+            nodes.insert(x, np.array([x, -x]), FREE, np.array([k]), tj=0.5, t_last=0.25)
+    xs = np.array(new)
+    Y = np.column_stack([2 * xs, 3 * xs])
+    status = np.where(xs < 1.0, CONTACT, FREE)
+    D, tj = xs[:, None] * 7.0, np.where(xs < 1.0, 1.5, 0.0)
+    for j, x in enumerate(xs):
+        one.insert(float(x), Y[j], int(status[j]), D[j], tj=float(tj[j]), t_last=1.0)
+    batch.insert_many(xs, Y, status, D, tj, 1.0)
+    assert batch.n == one.n and batch.xi_max == one.xi_max
+    for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+        np.testing.assert_array_equal(getattr(batch, name)[:batch.n], getattr(one, name)[:one.n])

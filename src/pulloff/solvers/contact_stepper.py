@@ -643,17 +643,7 @@ class Stepper:
         nodes.t_last[lo:hi] = t1
         status[released] = st.FREE
         if not step.fresh:  # an elastic solid's evaluations place their own elements
-            law = self.setup.law
-            for xv, Yv in zip(ev.xi[ev.virtual], ev.Y[ev.virtual]):
-                i = nodes.insert(float(xv), Yv, st.FREE, t_last=t1)
-                if 0.0 < xv <= ev.alpha:
-                    # New in the step and already inside the contact (a jump in, or an edge
-                    # overtaking the zone's new elements): it joins at the step's end, with
-                    # the dashpot state it has (virgin in a jump: the glassy response).
-                    nodes.status[i], nodes.tj[i] = st.CONTACT, t1
-                    if law.maxwell:
-                        nodes.D[i, :law.tau_arms.size] = (law.V @ Yv[:law.n_modes] - ev.Hf
-                                                          - self.setup.indenter.g(xv))
+            self._insert_new(ev, t1)
         if self.setup.law.maxwell and not self.setup.flat:
             self._edge_node(ev, t1)
         self.before = self.now
@@ -665,6 +655,21 @@ class Stepper:
         self._row(self.now)
         replay.refine(self)
         replay.thin(self)
+
+    def _insert_new(self, ev, t1) -> None:
+        """The step's new elements join the mesh. One new in the step and already inside the
+        contact (a jump in, or an edge overtaking the zone's new elements) joins it at the
+        step's end, with the dashpot state it has (virgin in a jump: the glassy response)."""
+        nodes, law = self.nodes, self.setup.law
+        xs, Ys = ev.xi[ev.virtual], ev.Y[ev.virtual]
+        inside = (xs > 0.0) & (xs <= ev.alpha)
+        D = np.zeros((xs.size, nodes.D.shape[1]))
+        if law.maxwell:
+            for j in np.nonzero(inside)[0]:
+                D[j, :law.tau_arms.size] = (law.V @ Ys[j, :law.n_modes] - ev.Hf
+                                            - self.setup.indenter.g(float(xs[j])))
+        nodes.insert_many(xs, Ys, np.where(inside, st.CONTACT, st.FREE), D,
+                          np.where(inside, t1, 0.0), t1)
 
     def _edge_node(self, ev, t1) -> None:
         """An advancing smooth contact gets a contact element at its new edge, joined now
