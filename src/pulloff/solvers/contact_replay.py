@@ -166,12 +166,13 @@ def thin(stepper) -> int:
     """Remove free elements deep inside a crowded zone, keeping at least ``2 thin_factor
     per_zone`` of them across its angle ``theta = acos(x/b)`` (the gap's variable, where the
     field is smooth away from the zone end) and every element nearer the end than that
-    spacing; returns how many went. A later zone that finds the region sparse replays elements back into it."""
+    spacing; returns how many went. A later zone that finds the region sparse replays
+    elements back into it."""
     now = stepper.now
     nodes = stepper.nodes
-    factor = thin_factor(stepper.setup.law)
     if now.beta <= 0.0 or now.beta <= now.alpha or now.phase not in GROWING:
         return 0
+    factor = thin_factor(stepper.setup.law)
     lo, hi = nodes.below(now.alpha), nodes.below(now.beta)
     idx = np.arange(lo, hi)
     idx = idx[(nodes.status[lo:hi] == st.FREE) & (nodes.xi[lo:hi] > now.alpha)
