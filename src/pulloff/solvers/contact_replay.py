@@ -194,7 +194,8 @@ def thin(stepper) -> int:
     theta_zone = math.atan2(math.sqrt((now.beta - now.alpha) * (now.beta + now.alpha)),
                             now.alpha) if now.alpha > 0.0 else 0.5 * math.pi
     spacing = theta_zone / (factor * stepper.per_zone)
-    theta = np.array([K.angle(x, now.beta) for x in nodes.xi[idx]])
+    x = nodes.xi[idx]  # the angle acos(x/b) without cancellation near b, as K.angle
+    theta = np.arctan2(np.sqrt(np.maximum((now.beta - x) * (now.beta + x), 0.0)), x)
     order = np.argsort(theta)
     drop, last = [], -math.inf
     for j, i in enumerate(order):

@@ -38,8 +38,8 @@ def _scale(v: np.ndarray, floor) -> np.ndarray:
 def same_events(values: Sequence[np.ndarray]) -> bool:
     """Whether every level found the same events: its outputs are nan in the same places. An
     event found on some levels only is not converged, whichever level lacks it."""
-    pattern = np.isnan(values[-1])
-    return all(np.array_equal(np.isnan(v), pattern) for v in values[:-1])
+    nan = np.isnan(np.asarray(values, dtype=float))  # (levels, outputs): one array op
+    return bool(np.all(nan == nan[-1]))
 
 
 def relative_spread(a: np.ndarray, b: np.ndarray, floor=None) -> float:
@@ -163,11 +163,10 @@ def extrapolate_measured(values: Sequence[np.ndarray], order: Order,
     stopped crossing the punch's first bond edge).
     """
     v0, v1, v2 = (np.asarray(v, dtype=float) for v in values[-3:])
-    if not same_events([v0, v1, v2]):
-        return v2.copy(), math.inf
     raw_estimate, measured = richardson(values[-3:], order, floor)
     if not math.isfinite(measured) or measured < DIVERGING_ORDER:
-        # Outputs unchanged, or levels not (yet) converging regularly: the finest level, with
+        # Events found on some levels only (richardson's estimate is then inf), outputs
+        # unchanged, or levels not (yet) converging regularly: the finest level, with
         # the larger of its last two changes as the estimate (as :func:`extrapolate`). Once
         # this was infinite, and a Prony punch behind a spring at rtol 1e-2 (levels 8e-6 and
         # 7e-6 apart) refined to n = 128, three times the time.
