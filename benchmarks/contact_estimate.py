@@ -54,9 +54,11 @@ def spring_scene(rtol):
 #: The reference's scenes at other speeds: (config, overrides).
 VARIANTS = {"separation_kv_v1e-2": ("separation_kv", ["loading.v=1e-2"]),
             "sls_finite_punch_v1e-4": ("sls_finite_punch", ["loading.v=1e-4"]),
+            "sls_finite_punch_v1e-7": ("sls_finite_punch", ["loading.v=1e-7"]),
             "sls_external_v1e-2": ("sls_finite_punch", ["loading.v=1e-2",
                                                         "geometry.cohesive_zone=external"]),
             "compliant_machine_k10": ("compliant_machine", ["loading.machine_stiffness=10"]),
+            "compliant_machine_k1": ("compliant_machine", ["loading.machine_stiffness=1"]),
             "sls_finite_punch_spring": ("sls_finite_punch",
                                         ["loading.machine_stiffness=100"])}
 

@@ -371,7 +371,11 @@ def test_a_flat_punchs_zone_alone_ends_at_its_located_fold(monkeypatch):
     """sls_finite_punch.yaml under a rigid pull: after the bond is gone the zone alone recedes
     and comes off at a fold, located as the maximum of the step over the zone end. Measured at
     n = 32: 2106 evaluations for the level against 4567 when bisected, t_separation +2.9e-6
-    off the reference (+3.0e-6 bisected)."""
+    off the reference (+3.0e-6 bisected). Since the crack's growth from the onset is
+    measured (``Stepper._growth``), this level's lost step misses states that exist (``T``
+    exceeds it over 40 % of the window): the edge of that stretch was taken as the fold and
+    the zone came off 2.7e-5 early; the fold is now located with twice the step (2291
+    evaluations, -3.3e-6)."""
     evaluations = count_evaluations(monkeypatch)
     ref = REFERENCE["sls_finite_punch"]
     level = contact.run_level(load_scene(CONFIGS / "sls_finite_punch.yaml"), 32)
@@ -425,19 +429,24 @@ def test_behind_a_spring_past_the_onset_a_kelvin_voigt_zone_is_neither_thinned_n
         assert contact_fold.foldable(stepper, "balance") is foldable
 
 
-def test_a_kelvin_voigt_bond_behind_a_soft_spring_arrests_without_a_separation():
-    """Behind 1 N/m the balance is lost three steps after the onset with a = 0.99 R at every
-    level. A Kelvin-Voigt bond cannot let go at once, and the moving-edge reference finds
-    the crack arrests there (its edge would advance again): the run stops and says so; it
-    once reported a separation 2 ms after the onset."""
+def test_a_kelvin_voigt_bond_behind_a_soft_spring_runs_through_and_snaps_at_a_zero():
+    """Behind 1 N/m the crack leaves its onset slowly and then runs through the bond in
+    5.6 ms at an almost constant force; the zone alone cannot hold the spring's force at
+    a = 0 and the punch snaps off there. The moving-edge reference agrees (snap_at_a_zero at
+    1.4432175 s, given the 5.5 ms propagation scale; from its own coarse pilot it stepped
+    over the run and reported an arrest). Before the crack's growth was measured on a log
+    scale (``Stepper._growth``) the balance was lost three steps after the onset at a = 0.99 R
+    at every level, and the run stopped with a crack-arrest note and no separation. Measured
+    at n = 16, 32, 64: t_separation -2.9e-5, -2.8e-5, -7.3e-6 off the reference, F_peak_total
+    -3.0e-5, -2.9e-5, -7.3e-6 (the onset itself is 4e-5 off at n = 16-32)."""
+    ref = REFERENCE["compliant_machine_k1"]
     scene = load_scene(CONFIGS / "compliant_machine.yaml",
                        overrides=["model.until=separation", "loading.machine_stiffness=1"])
-    level = contact.run_level(scene, 16)
-    assert [name for _, name in level.events] == ["onset", "balance"]  # lost, no snap
-    for name in ("t_separation", "F_peak_total", "t_peak_total"):
-        assert name not in level.summary
-    notes = contact._notes(level, scene, 0.0, 1e-3)
-    assert len(notes) == 1 and "crack arrests" in notes[0] and "no separation" in notes[0]
+    level = contact.run_level(scene, 32)
+    assert [name for _, name in level.events] == ["onset", "contact", "balance", "separated"]
+    assert not level.notes
+    for ours, theirs in (("t_separation", "t_separation"), ("F_peak_total", "F_peak_total")):
+        assert level.summary[ours] == pytest.approx(ref[theirs], rel=1e-4), ours
 
 
 def test_elastic_solid_behind_a_spring_comes_off_at_the_onset():
@@ -507,3 +516,26 @@ def test_finite_punch_behind_a_spring_reaches_its_strength_limit(material):
         ref = REFERENCE["finite_punch_spring_kv"]
         assert ref["F_onset_contact"] == 0.0 and res.F_contact_detach == 0.0
         assert res.t_detach == pytest.approx(ref["t_onset"], rel=1e-4)
+
+
+def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
+    """sls_finite_punch.yaml at 1e-7 m/s (the rate sweep's relaxed end): an elastic crack
+    would run at once at the onset; the dashpot makes it grow about exponentially from it
+    (~55 ms per e-fold against a 215 s pull), its force peaks 0.15 s later and the bond is
+    gone after 1.3 s. Steps sized by travel and time took several e-folds each at every
+    level, and the first step after the onset (1/16 of the last bonded one) jumped past
+    the peak: the levels n = 16, 32, 64 missed t_separation by 1.45e-3, 1.31e-3, 5.6e-4 and
+    the peak force by 1.9e-4, 1.5e-4, 4.4e-5, and the ladder went to n = 512 at rtol 1e-4.
+    Measured now: t_separation 6.4e-5, 2.3e-5, 7.4e-6; peak 1.4e-6, 4.2e-7, 9.3e-8."""
+    ref = REFERENCE["sls_finite_punch_v1e-7"]
+    scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
+                       overrides=["model.until=separation", "loading.v=1e-7"])
+    errors = {}
+    for n in (16, 32, 64):
+        summary = contact.run_level(scene, n).summary
+        errors[n] = {name: abs(summary[name] / ref[name] - 1.0)
+                     for name in ("t_separation", "F_peak_total")}
+    sep = [errors[n]["t_separation"] for n in (16, 32, 64)]
+    assert sep[0] > 2.0 * sep[1] > 4.0 * sep[2], errors  # converging, not stalled
+    assert sep[2] < 2e-5, errors
+    assert max(errors[n]["F_peak_total"] for n in errors) < 3e-6, errors

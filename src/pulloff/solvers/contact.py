@@ -303,10 +303,10 @@ def _notes(stepper, scene, estimate, rtol) -> list:
             notes.append(f"stopped at t = {t * s.T:.6g} s with the bond at a = "
                          f"{a_now:.4g} m: no lift balances the machine spring, and a "
                          "Kelvin-Voigt bond cannot let go at once (its dashpots), so this is "
-                         "no snap; either the crack arrests (behind soft springs its edge "
-                         "would advance again, which this model does not follow) or the "
-                         "steps are too coarse for the bond's last stretch; no separation or "
-                         "peak is reported")
+                         "no snap; either the steps are too coarse for the bond's last "
+                         "stretch (a finer rtol may carry it through) or the crack arrests "
+                         "(its edge would advance again, which this model does not follow); "
+                         "no separation or peak is reported")
         elif what == "steps":
             notes.append(f"stopped at t = {t * s.T:.6g} s: {MAX_STEPS} steps in one run")
     if not estimate <= rtol and not getattr(stepper, "interrupted", False):
