@@ -53,6 +53,12 @@ ONSET_SHRINK = 256.0
 #: 256 lost it at a = 0.155 and 0.095 R, 11.7 steps before the end, and reported an arrest;
 #: landed, they separate 3.9e-7 and 8.5e-8 off the reference.
 _LOST_BALANCE_HORIZON = 32.0
+#: The force range the steps start from [sigma_c L^2] (it grows with the force seen). A flat
+#: punch's bonded phase thus resolves its force on a log scale from t = 0: sls_finite_punch
+#: at n = 64 spends a third of its 998 rows before 1e-3 of the onset time. From 0.1 it took
+#: 701 rows with the onset as accurate, but the coarse levels' peak forces and a thinning
+#: threshold moved with the steps; not adopted (measured, left for a later change).
+FORCE_RANGE = 1e-3
 #: A zone extrapolated to vanish must still hold this share of the way to its end.
 _HOLD_SHARE = 0.9
 
@@ -87,7 +93,8 @@ class Stepper:
                                                     if d.end[0] == "lift"]
                            + [t_scale * abs(d.rate) for d in setup.drives
                               if d.kind == "speed" and d.end == ("event", "end")])
-        self.F_range = max([1e-3] + [abs(d.end[1]) for d in setup.drives if d.end[0] == "force"])
+        self.F_range = max([FORCE_RANGE]
+                           + [abs(d.end[1]) for d in setup.drives if d.end[0] == "force"])
         self.now = self._start()
         self.before = None
         self._begin_segment()
