@@ -129,7 +129,8 @@ def main(argv=None):
         t0 = time.time()
         p = dict(p)
         scales = p.pop("scales", None)
-        res = flat_punch_reference(**p, scales=scales, rtol=args.rtol, N0=16, min_level=1, max_level=7,
+        res = flat_punch_reference(**p, scales=scales, rtol=args.rtol, N0=16, min_level=1,
+                                   max_level=7,
                                    time_budget=args.budget, verbose=True)
         wall = time.time() - t0
         entry = {k: res[k] for k in SCALARS}
