@@ -130,9 +130,11 @@ def test_fast_pull_comes_apart_by_collapse_at_every_level():
     out: the zone end's value in the gap integral was extrapolated across the punch's first
     bond edge, where the displacement has a kink, and the gap jumped as the end passed a node.
     With no stencil across that kink (the end value and the integral), the levels converge
-    from one side: measured -3.2e-5 and -2.2e-6 off the reference at n = 32 and 128 (a
+    from one side: measured -1.9e-5 and -2.7e-6 off the reference at n = 32 and 128 (a
     stencil across it had put them at +2.3e-6, +6.6e-7, +1.7e-6, +1.9e-6 at n = 32..256,
-    not converging)."""
+    not converging). Their order is low: -9.6e-5, -1.9e-5, -7.7e-6, -2.7e-6, -1.1e-6 at
+    n = 16..256 (1.3-1.5 per doubling from n = 32; before the landing on a = 0 under a driven
+    lift, n = 32 was -3.1e-5 and the rest the same)."""
     scene = load_scene(CONFIGS / "separation_kv.yaml",
                        overrides=["loading.v=1e-2", "model.until=separation"])
     reference = REFERENCE["separation_kv_v1e-2"]["t_separation"]
@@ -140,8 +142,9 @@ def test_fast_pull_comes_apart_by_collapse_at_every_level():
     for n in (32, 128):
         level = contact.run_level(scene, n)
         assert [name for _, name in level.events][-2:] == ["separation", "separated"]
-        errors.append(abs(level.summary["t_separation"] / reference - 1.0))
-    assert errors[1] < 5e-6 and errors[0] > 8.0 * errors[1], errors
+        errors.append(level.summary["t_separation"] / reference - 1.0)
+    assert errors[0] < errors[1] < 0.0, errors  # early at both, the finer less so
+    assert abs(errors[1]) < 5e-6 and abs(errors[0]) > 4.0 * abs(errors[1]), errors
 
 
 def test_finite_punch_force_never_exceeds_the_strength_limit():
@@ -395,7 +398,10 @@ def test_a_growing_zone_is_thinned_and_the_onset_keeps_its_digits(monkeypatch, c
     n = 64: separation_kv keeps 565 elements against 1279 unthinned and its onset moves by
     2.5e-11 (7.8e-11 at n = 128, 2.7e-12 at 256; the level's own error against the reference
     is 9e-10); the standard linear solid at 1e-2 m/s keeps 1235 against 3018 and moves by
-    5e-13 (its onset stalls near 1e-9 at n = 256-512 thinned)."""
+    5e-13 (its onset stalls near 1e-9 at n = 256-512 thinned). Measured with the steps
+    resolving the force on a log scale from 1e-3 (``FORCE_RANGE``; by default from 1): many
+    elements enter there, and at n = 64 the default SLS run has too few to thin."""
+    monkeypatch.setattr(contact_stepper, "FORCE_RANGE", 1e-3)
     scene = load_scene(CONFIGS / config, overrides=["model.until=detach"] + overrides)
     thinned = contact.run_level(scene, 64)
     monkeypatch.setattr(contact_replay, "GROWING", ())
@@ -489,8 +495,8 @@ def test_finite_punch_behind_a_spring_reaches_its_strength_limit(material):
     than under a rigid pull (measured 1e-14). A Kelvin-Voigt one reaches the limit too (once
     reported no detachment at all: the spring's lost balance hid the face's failure; then it
     snapped at a ~ 1/n with a contact force that fell at first order): the contact carries
-    nothing and the time is the reference's (``finite_punch_spring_kv``; measured 2.9e-5 off
-    at rtol 1e-2, 1.3e-6 at 1e-4)."""
+    nothing and the time is the reference's (``finite_punch_spring_kv``; measured 2.0e-5 off
+    at rtol 1e-2, 7.1e-6 at 1e-4, estimate 9.0e-6)."""
     R, sigma_c, k_m, v = 1e-5, 1e6, 1e3, 1e-3
 
     def run(machine):
@@ -526,7 +532,9 @@ def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
     level, and the first step after the onset (1/16 of the last bonded one) jumped past
     the peak: the levels n = 16, 32, 64 missed t_separation by 1.45e-3, 1.31e-3, 5.6e-4 and
     the peak force by 1.9e-4, 1.5e-4, 4.4e-5, and the ladder went to n = 512 at rtol 1e-4.
-    Measured now: t_separation 6.4e-5, 2.3e-5, 7.4e-6; peak 1.4e-6, 4.2e-7, 9.3e-8."""
+    Measured now: t_separation 7.4e-5, 3.0e-5, 1.2e-5; peak 4.0e-6, 1.3e-6, 3.3e-7 (with the
+    bonded phase's steps from a force range of 1e-3: 6.4e-5, 2.3e-5, 7.4e-6 and 1.4e-6,
+    4.2e-7, 9.3e-8, the peak stalling on the finer levels of other speeds)."""
     ref = REFERENCE["sls_finite_punch_v1e-7"]
     scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
                        overrides=["model.until=separation", "loading.v=1e-7"])
@@ -538,7 +546,9 @@ def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
     sep = [errors[n]["t_separation"] for n in (16, 32, 64)]
     assert sep[0] > 2.0 * sep[1] > 4.0 * sep[2], errors  # converging, not stalled
     assert sep[2] < 2e-5, errors
-    assert max(errors[n]["F_peak_total"] for n in errors) < 3e-6, errors
+    peak = [errors[n]["F_peak_total"] for n in (16, 32, 64)]
+    assert peak[0] > 2.0 * peak[1] > 4.0 * peak[2], errors
+    assert peak[2] < 1e-6, errors
 
 
 def test_a_prony_punchs_zone_alone_is_not_lost_to_the_landing_on_a_zero(monkeypatch):
@@ -555,3 +565,25 @@ def test_a_prony_punchs_zone_alone_is_not_lost_to_the_landing_on_a_zero(monkeypa
     when = {name: t for t, name in level.events}
     assert when["zone"] > when["contact"]
     assert level.summary["t_separation"] == pytest.approx(ref["t_separation"], rel=2e-5)
+
+
+@pytest.mark.parametrize("config", ["sls_finite_punch", "prony_external", "separation_kv"])
+def test_the_compiled_receding_secant_takes_the_python_secants_steps(monkeypatch, config):
+    """A receding flat punch's edge is found by secant iterations compiled with their residual
+    (kernels.contact.receding_secant: the search took ~7 Python evaluations per step, ~2/3 of
+    a standard linear solid's run). It must be the same search: every row of a level equal,
+    bitwise, to the Python iterations' (standard linear solid, two Prony arms and
+    Kelvin-Voigt, to separation)."""
+    scene = load_scene(CONFIGS / f"{config}.yaml", overrides=["model.until=separation"])
+    searches = []
+    compiled_secant = contact_step.Step.receding_secant
+
+    def counted(step, H):
+        searches.append(H)
+        return compiled_secant(step, H)
+    monkeypatch.setattr(contact_step.Step, "receding_secant", counted)
+    compiled = contact.run_level(scene, 16)
+    monkeypatch.setattr(contact_step.Step, "receding_secant", lambda step, H: None)
+    python = contact.run_level(scene, 16)
+    assert len(searches) > 20  # the edge receded over many steps (37 for Kelvin-Voigt)
+    assert np.array_equal(np.array(compiled.rows), np.array(python.rows))

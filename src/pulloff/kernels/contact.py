@@ -905,3 +905,139 @@ def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha):
     else:
         total += v_a * alpha
     return total
+
+
+# --- a receding flat punch's edge, compiled ---------------------------------------------------
+#: Entries of ``edges`` in :func:`receding_gap`: the edges now and one step earlier (nan after
+#: an event), the earlier step's length in this one's (nan: none), the new elements' spacing
+#: and the step's released-element count.
+E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING, E_K_ALPHA = range(7)
+_TINY = 1e-13
+
+
+@njit(cache=True)
+def _quadratic(prev, now, new, r, out):
+    """``out`` = the quadratic path through ``(-r, prev)``, ``(0, now)``, ``(1, new)`` (linear
+    through the last two where ``r`` or ``prev`` is nan): as ``contact_step.quadratic_path``."""
+    if math.isnan(r) or r <= 0.0 or not math.isfinite(prev):
+        out[0], out[1], out[2] = now, new - now, 0.0
+        return
+    p2 = (prev - now + r * (new - now)) / (r * (r + 1.0))
+    out[0], out[1], out[2] = now, new - now - p2, p2
+
+
+@njit(cache=True)
+def receding_gap(alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
+    """``gap(b) - 1`` at the end of a flat punch's step with the edge at ``alpha`` and the zone
+    end from the edge condition (``contact_phases.receding``'s residual, bitwise: the same
+    element sums, paths and ranges as ``Step.evaluate``). ``sc0``: the step's constants with
+    the lift and its rate set; ``lift``: its path; ``n_all`` elements in ``mesh``."""
+    xi, Y, status, D, tj, t_last = mesh
+    ctil, kappa_arms, tau_arms, V_inv = law
+    Hf1 = stepw[6]
+    H1 = sc0[S_H1]
+    load = sc0[S_KAPPA] * (H1 + _profile(sc0, alpha, prof))
+    na = tau_arms.size
+    if na > 0:
+        arms = 0.0
+        for i in range(na):
+            arms += kappa_arms[i] * (H1 - Hf1[i])
+        mem = np.empty(na)
+        t1 = sc0[S_T0] + sc0[S_DT]
+        load = load + arms - _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1,
+                                     alpha, mem)
+    else:
+        load = load + sc0[S_C] * sc0[S_HDOT]
+    q = max(load, 0.0)
+    beta = math.sqrt(alpha * alpha + q * q)  # as edge_zone: numba's hypot rounds otherwise
+    paths = np.empty((3, 3))
+    _quadratic(edges[E_ALPHA_PREV], edges[E_ALPHA], alpha, edges[E_R], paths[0])
+    _quadratic(edges[E_BETA_PREV], edges[E_BETA], beta, edges[E_R], paths[1])
+    paths[2, :] = lift
+    bp = paths[1]
+    xs = xi[:n_all]
+    lo = np.searchsorted(xs, min(edges[E_ALPHA], alpha) - _TINY)
+    if beta > 0.0:
+        b_top = max(edges[E_BETA], beta, bp[0] + 0.5 * (bp[1] + 0.5 * bp[2]))
+        hi = max(np.searchsorted(xs, b_top * (1.0 + 1e-12) + _TINY), lo)
+    else:
+        hi = lo + 1 if n_all and xi[0] == 0.0 and lo == 0 else lo
+    sc = sc0.copy()
+    k_alpha = int(edges[E_K_ALPHA])
+    if alpha < edges[E_ALPHA]:
+        k_alpha = max(k_alpha, int(math.ceil((edges[E_ALPHA] - alpha) / edges[E_SPACING])))
+        sc[S_K_ALPHA] = k_alpha
+    size = (hi - lo) + k_alpha + int(sc[S_K_BETA]) + 1
+    nm = stepw[0].size
+    out = (np.empty(size), np.empty((size, nm)), np.empty(size), np.empty(size, dtype=np.int64))
+    res = np.empty(R_N)
+    evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha, beta, n_all, prof, out, res)
+    return res[R_GAP] - 1.0
+
+
+_XTOL = 1e-14
+_STALL = 1e-13
+_SMALL_RESIDUAL = 1e-9
+
+
+@njit(cache=True)
+def receding_secant(x_held, f_held, x_guess, lo, hi, reach, mesh, law, stepw, prof, sc0, edges,
+                    lift, n_all):
+    """``contact_phases._secant`` on :func:`receding_gap`, step for step (the same iterates,
+    brackets and stopping rules; see there): the root, or nan where it gives up."""
+    x0, f0 = x_held, f_held
+    x1 = min(max(x_guess, lo), hi)
+    if x1 == x0:
+        return math.nan
+    f1 = receding_gap(x1, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+    bracketed, b_lo, b_hi = False, 0.0, 0.0
+    slope = math.nan
+    for _ in range(40):
+        if math.isnan(f1):
+            return math.nan
+        if abs(x1 - x0) > 1e-9 * max(abs(x1), 1e-300):
+            slope = (f1 - f0) / (x1 - x0) if x1 != x0 else math.nan
+        if f1 == 0.0 or abs(f1) <= 1e-14:
+            return x1
+        if (f1 > 0.0) != (f0 > 0.0):
+            bracketed, b_lo, b_hi = True, min(x0, x1), max(x0, x1)
+        elif bracketed and not b_lo <= x1 <= b_hi:
+            return math.nan
+        if abs(x1 - x0) <= _XTOL * max(abs(x1), 1e-300) and bracketed:
+            return x1
+        x2 = x1 - f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else math.nan
+        if (abs(f1) <= _SMALL_RESIDUAL
+                and abs(f1) <= abs(slope) * _STALL * max(abs(x1), 1e-300)):
+            return x1
+        if bracketed and not b_lo < x2 < b_hi:
+            x2 = 0.5 * (b_lo + b_hi)
+        if not (lo <= x2 <= hi) or abs(x2 - x_held) > reach:
+            return math.nan
+        f2 = receding_gap(x2, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+        if bracketed and not math.isnan(f2):
+            if (f2 > 0.0) != (f1 > 0.0):
+                b_lo, b_hi = min(x1, x2), max(x1, x2)
+            else:
+                keep = x0 if (f0 > 0.0) != (f2 > 0.0) else (
+                    b_lo if x2 > 0.5 * (b_lo + b_hi) else b_hi)
+                b_lo, b_hi = min(keep, x2), max(keep, x2)
+        x0, f0, x1, f1 = x1, f1, x2, f2
+    return math.nan
+
+
+@njit(cache=True)
+def merge_sorted(arr, n, at, new):
+    """Insert the rows ``new`` into the first ``n`` rows of ``arr`` (which has room), new row
+    ``j`` before old row ``at[j]`` (``at`` ascending), in place: ``np.insert`` without its
+    copies (a step's new elements, every step)."""
+    j = at.size - 1
+    for i in range(n - 1, -1, -1):
+        while j >= 0 and at[j] > i:
+            arr[i + j + 1] = new[j]
+            j -= 1
+        if j < 0:
+            return
+        arr[i + j + 1] = arr[i]
+    while j >= 0:
+        arr[j] = new[j]
+        j -= 1

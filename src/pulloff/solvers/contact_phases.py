@@ -104,11 +104,13 @@ def _bracketed(f, a, fa, b, fb):
     return b
 
 
-def root(f, x_held, f_held, x_guess, lo, hi, wide=False):
+def root(f, x_held, f_held, x_guess, lo, hi, wide=False, secant=None):
     """The root of ``f`` nearest ``x_held`` inside ``[lo, hi]`` (the branch the solution is
-    on): brackets grow from ``x_held`` geometrically, the side of ``x_guess`` first, until
-    ``f`` changes sign; None if it does not within a reach of a quarter of ``x_held`` (or of
-    the length unit) or four predicted steps: a root further away is another branch."""
+    on): secant iterations from the predictor ``x_guess`` first (``secant``, if given, runs
+    them on a compiled ``f``); where they give up, brackets grow from ``x_held``
+    geometrically, the side of ``x_guess`` first, until ``f`` changes sign; None if it does
+    not within a reach of a quarter of ``x_held`` (or of the length unit) or four predicted
+    steps: a root further away is another branch."""
     if f_held == 0.0:
         return x_held
     first = 1.0 if x_guess >= x_held else -1.0
@@ -117,7 +119,10 @@ def root(f, x_held, f_held, x_guess, lo, hi, wide=False):
         reach = WIDE_REACH * max(abs(x_held), abs(x_guess), 1.0)
     lo, hi = max(lo, x_held - reach), min(hi, x_held + reach)
     if x_guess != x_held:
-        quick = _secant(f, x_held, f_held, x_guess, lo, hi, reach)
+        if secant is None:
+            quick = _secant(f, x_held, f_held, x_guess, lo, hi, reach)
+        else:
+            quick = secant(x_held, f_held, x_guess, lo, hi, reach)
         if quick is not None:
             return quick
     step = max(abs(x_guess - x_held), 1e-7 * max(abs(x_held), 1.0))
@@ -169,8 +174,8 @@ def _Hf(step, H):
 
 def edge_zone(step, H, alpha):
     """The zone end the edge condition puts with the edge at ``alpha``."""
-    Q = step.contact_load(alpha, H, step.lift_rate(H), _Hf(step, H))
-    return math.hypot(alpha, max(Q, 0.0))
+    Q = max(step.contact_load(alpha, H, step.lift_rate(H), _Hf(step, H)), 0.0)
+    return math.sqrt(alpha * alpha + Q * Q)  # (kernels.contact.receding_gap: the same sum)
 
 
 def receding(step, H, guess_alpha):
@@ -182,7 +187,7 @@ def receding(step, H, guess_alpha):
 
     r_held = residual(now.alpha)
     alpha = root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha,
-                  step.jump)
+                 step.jump, step.receding_secant(H) if step.s.setup.flat else None)
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
     return step.evaluate(alpha, edge_zone(step, H, alpha), H)

@@ -7,6 +7,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..kernels.contact import merge_sorted
+
 FREE, CONTACT = 0, 1
 
 #: Phases of the contact (MODEL.md sections 3, 6 and 9).
@@ -77,8 +79,7 @@ class Nodes:
                    "t_last": np.full(x.size, t_last)}
         for name, new in columns.items():
             arr = getattr(self, name)
-            merged = np.insert(arr[:self.n], at, np.asarray(new, dtype=arr.dtype)[order], axis=0)
-            arr[:merged.shape[0]] = merged
+            merge_sorted(arr, self.n, at, np.asarray(new, dtype=arr.dtype)[order])
         self.n += x.size
         self.xi_max = max(self.xi_max, float(np.max(x)))
 

@@ -73,6 +73,13 @@ class Step:
         self._free = None  # (x, modes) of the free elements at the start, gathered once
         self.k_alpha = self.k_beta = 0  # new elements per step (set by the stepper)
         self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv)
+        # A step's trials share their lift (a driven one, or the balance's few): its path,
+        # rate and the arms' filtered lift at the end are computed once per lift.
+        self._driven = None
+        if stepper.lift_driven:
+            drive = stepper.drive
+            self._driven = (now.H, drive.rate * dt if drive.kind == "speed" else 0.0, 0.0)
+        self._at_end = {}
         # The phase searches come back to points they have evaluated (the held edge, the
         # root they end on): a step answers those from its memo.
         self._memo = {}
@@ -102,21 +109,34 @@ class Step:
 
     def lift_path(self, H_new):
         """The lift over the step: exact (linear) under a driven lift, else the quadratic."""
-        drive = self.s.drive
-        if self.s.lift_driven:
-            return self.now.H, drive.rate * self.dt if drive.kind == "speed" else 0.0, 0.0
+        if self._driven is not None:
+            return self._driven
         return self.path("H", H_new)
+
+    def _end_of(self, H_new):
+        """``(lift path as an array, dH/dt at the end, Hf at the end)`` for the lift
+        ``H_new``, computed once per lift (the array ``Hf`` is shared: not to be changed)."""
+        got = self._at_end.get(H_new)
+        if got is None:
+            path = np.array(self.lift_path(H_new), float)
+            Hf = self.now.Hf
+            if self.arm_mus.size:
+                Hf = np.empty(self.now.Hf.size)
+                K._filtered_lift(self.now.Hf, self.arm_mus, path, 1.0, Hf)
+            got = self._at_end[H_new] = (path, (path[1] + 2.0 * path[2]) / self.dt, Hf)
+        return got
 
     def lift_rate(self, H_new):
         """``dH/dt`` at the end of the step (the Kelvin-Voigt contact load needs it)."""
-        h0, h1, h2 = self.lift_path(H_new)
-        return (h1 + 2.0 * h2) / self.dt
+        return self._end_of(H_new)[1]
 
     def filtered_lift(self, H_new, s=1.0):
-        """The arms' filtered lift ``Hf`` (``tau dHf/dt = H - Hf``) at fraction ``s``."""
+        """The arms' filtered lift ``Hf`` (``tau dHf/dt = H - Hf``) at fraction ``s`` (at the
+        end: shared between the step's trials, not to be changed)."""
+        if s == 1.0:
+            return self._end_of(H_new)[2]
         out = np.empty(self.now.Hf.size)
-        K._filtered_lift(self.now.Hf, self.arm_mus, np.array(self.lift_path(H_new), float), s,
-                         out)
+        K._filtered_lift(self.now.Hf, self.arm_mus, self._end_of(H_new)[0], s, out)
         return out
 
     # --- the contact side ----------------------------------------------------------------
@@ -168,6 +188,30 @@ class Step:
         E = self.filtered_lift(H_new, s_c) + G + self.s.contact_memory_arms(x, t)
         return law.V_inv @ E
 
+    def receding_secant(self, H_new):
+        """``contact_phases._secant`` for a flat punch's receding edge at the lift ``H_new``,
+        compiled (:func:`pulloff.kernels.contact.receding_secant`: the same iterates, without
+        Python between them): ``(x_held, f_held, x_guess, lo, hi, reach) -> root or None``."""
+        s, now, before = self.s, self.now, self.before
+        nodes, law = s.nodes, s.setup.law
+        lift, Hdot, Hf = self._end_of(H_new)
+        sc = self.constants.copy()
+        sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+        nan = math.nan
+        edges = np.array([now.alpha, now.beta, before.alpha if before is not None else nan,
+                          before.beta if before is not None else nan,
+                          nan if self.r is None else self.r, s.spacing(now), self.k_alpha])
+        mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+        stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf,
+                 Hf if law.maxwell else now.Hf)
+        table = s.setup.indenter.table
+
+        def secant(x_held, f_held, x_guess, lo, hi, reach):
+            x = K.receding_secant(x_held, f_held, x_guess, lo, hi, reach, mesh, self.law,
+                                  stepw, table, sc, edges, lift, nodes.n)
+            return None if math.isnan(x) else x
+        return secant
+
     # --- the free side -------------------------------------------------------------------
     def evaluate(self, alpha, beta, H_new) -> Evaluation:
         """The end of the step for trial edges and lift (:func:`pulloff.kernels.contact.
@@ -183,17 +227,21 @@ class Step:
         nodes = s.nodes
         law = s.setup.law
         now = self.now
-        Hdot = self.lift_rate(H_new)
-        Hf = self.filtered_lift(H_new) if law.maxwell else now.Hf
+        lift, Hdot, Hf = self._end_of(H_new)
+        if not law.maxwell:
+            Hf = now.Hf
         zone = beta > 0.0
         bp = self.path("beta", beta)
-        b_top = max(now.beta, beta, K.path_value(*bp, 0.5)) if zone else 0.0
+        b_top = max(now.beta, beta, bp[0] + 0.5 * (bp[1] + 0.5 * bp[2])) if zone else 0.0
         lo = nodes.below(min(now.alpha, alpha) - _TINY)
         if zone:
             hi = max(nodes.below(b_top * (1.0 + 1e-12) + _TINY), lo)
         else:  # no zone: only the element at the centre matters (its gap)
             hi = lo + 1 if nodes.n and nodes.xi[0] == 0.0 and lo == 0 else lo
-        paths = np.array([self.path("alpha", alpha), bp, self.lift_path(H_new)])
+        paths = np.empty((3, 3))
+        paths[0] = self.path("alpha", alpha)
+        paths[1] = bp
+        paths[2] = lift
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         if self.fresh:
