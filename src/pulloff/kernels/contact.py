@@ -1041,3 +1041,38 @@ def merge_sorted(arr, n, at, new):
     while j >= 0:
         arr[j] = new[j]
         j -= 1
+
+
+@njit(cache=True)
+def fitted_radau3_rows(mus, out):
+    """:func:`fitted_radau3` for every ``mus[k]`` into ``out[k]`` (one call per step)."""
+    for k in range(mus.size):
+        fitted_radau3(mus[k], out[k])
+
+
+@njit(cache=True)
+def _rows(new, order, width):
+    """``new[order]`` with ``width`` columns (missing ones 0: an elastic element has no
+    modes, while the mesh keeps one column)."""
+    out = np.zeros((order.size, width))
+    for j in range(order.size):
+        for k in range(min(width, new.shape[1])):
+            out[j, k] = new[order[j], k]
+    return out
+
+
+@njit(cache=True)
+def insert_batch(mesh, n, x, Y, status, D, tj, t_last):
+    """Insert new elements (at ``x``, any order, with their rows of ``Y``, ``D``, ``status``
+    and ``tj``; all valid at ``t_last``) into the first ``n`` of ``mesh`` = (xi, Y, status, D,
+    tj, t_last), which has room, keeping it sorted: as one-by-one inserts would."""
+    xi_m, Y_m, status_m, D_m, tj_m, t_last_m = mesh
+    order = np.argsort(x, kind="mergesort")
+    xs = x[order]
+    at = np.searchsorted(xi_m[:n], xs)
+    merge_sorted(xi_m, n, at, xs)
+    merge_sorted(Y_m, n, at, _rows(Y, order, Y_m.shape[1]))
+    merge_sorted(status_m, n, at, status[order])
+    merge_sorted(D_m, n, at, _rows(D, order, D_m.shape[1]))
+    merge_sorted(tj_m, n, at, tj[order])
+    merge_sorted(t_last_m, n, at, np.full(x.size, t_last))

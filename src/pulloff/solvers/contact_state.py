@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..kernels.contact import merge_sorted
+from ..kernels.contact import insert_batch
 
 FREE, CONTACT = 0, 1
 
@@ -66,20 +66,19 @@ class Nodes:
     def insert_many(self, x: np.ndarray, Y: np.ndarray, status: np.ndarray, D: np.ndarray,
                     tj: np.ndarray, t_last: float) -> None:
         """Put elements at ``x`` (any order; rows of ``Y``, ``D``), as :meth:`insert` one by
-        one would, in one merge: a step's new elements once cost a shift of every element
+        one would, in one compiled merge: a step's new elements once cost a shift of every element
         beyond them each (seed_flat_punch at n = 64 leaves 22000 behind its receding zone:
         a third of the run went into those shifts)."""
         if x.size == 0:
             return
-        order = np.argsort(x, kind="stable")
         while self.n + x.size > self.xi.shape[0]:
             self._grow()
-        at = np.searchsorted(self.xi[:self.n], x[order])
-        columns = {"xi": x, "Y": Y, "status": status, "D": D, "tj": tj,
-                   "t_last": np.full(x.size, t_last)}
-        for name, new in columns.items():
-            arr = getattr(self, name)
-            merge_sorted(arr, self.n, at, np.asarray(new, dtype=arr.dtype)[order])
+        insert_batch((self.xi, self.Y, self.status, self.D, self.tj, self.t_last), self.n,
+                     np.ascontiguousarray(x, dtype=float),
+                     np.ascontiguousarray(Y, dtype=float),
+                     np.ascontiguousarray(status, dtype=np.int64),
+                     np.ascontiguousarray(D, dtype=float),
+                     np.ascontiguousarray(tj, dtype=float), float(t_last))
         self.n += x.size
         self.xi_max = max(self.xi_max, float(np.max(x)))
 

@@ -51,6 +51,23 @@ class Evaluation:
     Hf: np.ndarray  # the arms' filtered lift at the end of the step
 
 
+def is_fresh(setup) -> bool:
+    """Whether each evaluation places its own elements: an elastic smooth contact has no
+    history."""
+    return not setup.flat and setup.law.c == 0.0 and not setup.law.maxwell
+
+
+def step_constants(setup) -> np.ndarray:
+    """The constants ``sc`` (:func:`pulloff.kernels.contact.evaluate_step`) every step of
+    ``setup`` shares, the law's and the indenter's; a step copies them and adds its own."""
+    law, ind = setup.law, setup.indenter
+    sc = np.zeros(18)
+    sc[[K.S_KAPPA, K.S_C, K.S_D, K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G, K.S_FRESH]] = (
+        law.kappa_inf, law.c, law.d, 1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n,
+        1.0 if is_fresh(setup) else 0.0)
+    return sc
+
+
 class Step:
     """A trial step of length ``dt`` from ``now``; ``before`` is the instant one step earlier
     on the same smooth stretch (None after an event)."""
@@ -64,8 +81,7 @@ class Step:
         self.decay = np.exp(-self.mus)
         self.zdt = law.z * dt
         self.w3 = np.zeros((max(law.n_modes, 1), 3))
-        for k, mu in enumerate(self.mus):
-            K.fitted_radau3(mu, self.w3[k])
+        K.fitted_radau3_rows(self.mus, self.w3)
         self.r = (now.t - before.t) / dt if before is not None else None
         self.before = before
         self.arm_mus = dt / law.tau_arms if law.maxwell else np.zeros(0)
@@ -83,16 +99,10 @@ class Step:
         # The phase searches come back to points they have evaluated (the held edge, the
         # root they end on): a step answers those from its memo.
         self._memo = {}
-        setup = stepper.setup
-        ind = setup.indenter
-        sc = np.zeros(18)
-        # An elastic smooth contact has no history: each evaluation places its own elements.
-        self.fresh = not setup.flat and law.c == 0.0 and not law.maxwell
-        sc[[K.S_T0, K.S_DT, K.S_ALPHA0, K.S_BETA0, K.S_XIMAX, K.S_KAPPA, K.S_C, K.S_D,
-            K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G, K.S_FRESH]] = (
-            now.t, dt, now.alpha, now.beta, stepper.nodes.xi_max, law.kappa_inf, law.c, law.d,
-            1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n, 1.0 if self.fresh else 0.0)
-        sc[K.S_KINK] = stepper.first_edge
+        self.fresh = stepper.fresh
+        sc = stepper.step_constants.copy()
+        sc[K.S_T0], sc[K.S_DT], sc[K.S_ALPHA0], sc[K.S_BETA0] = now.t, dt, now.alpha, now.beta
+        sc[K.S_XIMAX], sc[K.S_KINK] = stepper.nodes.xi_max, stepper.first_edge
         self._constants = sc
 
     @property

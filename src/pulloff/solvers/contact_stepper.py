@@ -28,7 +28,7 @@ from . import contact_phases as phases
 from . import contact_replay as replay
 from . import contact_state as st
 from .contact_setup import FLAT_EXTERNAL, FLAT_INTERNAL, Setup
-from .contact_step import Evaluation, Step
+from .contact_step import Evaluation, Step, is_fresh, step_constants
 
 #: Nodes per zone width at resolution n = 64 (they grow like sqrt(n): the gap quadrature is
 #: fourth order in their spacing, the step second order).
@@ -90,6 +90,8 @@ class Stepper:
         law = setup.law
         self.nodes = st.Nodes(law.n_modes, law.kappa_arms.size)
         self._arms_scratch = np.empty(law.tau_arms.size)
+        self.fresh = is_fresh(setup)
+        self.step_constants = step_constants(setup)
         self.per_zone = _NODES_PER_ZONE * math.sqrt(n / 64.0)
         self.rows = []
         self.row_Hf = []  # the arms' filtered lift at each row (a replay needs it)
