@@ -568,24 +568,25 @@ def test_a_prony_punchs_zone_alone_is_not_lost_to_the_landing_on_a_zero(monkeypa
 
 
 @pytest.mark.parametrize("config", ["sls_finite_punch", "prony_external", "separation_kv"])
-def test_the_compiled_receding_secant_takes_the_python_secants_steps(monkeypatch, config):
-    """A receding flat punch's edge is found by secant iterations compiled with their residual
-    (kernels.contact.receding_secant: the search took ~7 Python evaluations per step, ~2/3 of
-    a standard linear solid's run). It must be the same search: every row of a level equal,
-    bitwise, to the Python iterations' (standard linear solid, two Prony arms and
-    Kelvin-Voigt, to separation)."""
+def test_the_compiled_secants_take_the_python_secants_steps(monkeypatch, config):
+    """A receding flat punch's edge and a zone end are found by secant iterations compiled
+    with their residual (kernels.contact.edge_secant: the receding edge's search took ~7
+    Python evaluations per step, ~2/3 of a standard linear solid's run). They must be the
+    same searches: every row of a level equal, bitwise, to the Python iterations' (standard
+    linear solid, two Prony arms and Kelvin-Voigt, to separation)."""
     scene = load_scene(CONFIGS / f"{config}.yaml", overrides=["model.until=separation"])
     searches = []
-    compiled_secant = contact_step.Step.receding_secant
+    compiled_secant = contact_step.Step.compiled_secant
 
-    def counted(step, H):
-        searches.append(H)
-        return compiled_secant(step, H)
-    monkeypatch.setattr(contact_step.Step, "receding_secant", counted)
+    def counted(step, H, alpha=None):
+        searches.append(alpha)
+        return compiled_secant(step, H, alpha)
+    monkeypatch.setattr(contact_step.Step, "compiled_secant", counted)
     compiled = contact.run_level(scene, 16)
-    monkeypatch.setattr(contact_step.Step, "receding_secant", lambda step, H: None)
+    monkeypatch.setattr(contact_step.Step, "compiled_secant", lambda step, H, alpha=None: None)
     python = contact.run_level(scene, 16)
-    assert len(searches) > 20  # the edge receded over many steps (37 for Kelvin-Voigt)
+    assert searches.count(None) > 20  # the edge receded over many steps (37 for Kelvin-Voigt)
+    assert searches.count(0.0) > 5  # and the zone alone ended over some
     assert np.array_equal(np.array(compiled.rows), np.array(python.rows))
 
 

@@ -907,8 +907,8 @@ def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha):
     return total
 
 
-# --- a receding flat punch's edge, compiled ---------------------------------------------------
-#: Entries of ``edges`` in :func:`receding_gap`: the edges now and one step earlier (nan after
+# --- a phase's edge search, compiled ------------------------------------------------------------
+#: Entries of ``edges`` in :func:`trial_gap`: the edges now and one step earlier (nan after
 #: an event), the earlier step's length in this one's (nan: none), the new elements' spacing
 #: and the step's released-element count.
 E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING, E_K_ALPHA = range(7)
@@ -927,29 +927,12 @@ def _quadratic(prev, now, new, r, out):
 
 
 @njit(cache=True)
-def receding_gap(alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
-    """``gap(b) - 1`` at the end of a flat punch's step with the edge at ``alpha`` and the zone
-    end from the edge condition (``contact_phases.receding``'s residual, bitwise: the same
-    element sums, paths and ranges as ``Step.evaluate``). ``sc0``: the step's constants with
-    the lift and its rate set; ``lift``: its path; ``n_all`` elements in ``mesh``."""
-    xi, Y, status, D, tj, t_last = mesh
-    ctil, kappa_arms, tau_arms, V_inv = law
-    Hf1 = stepw[6]
-    H1 = sc0[S_H1]
-    load = sc0[S_KAPPA] * (H1 + _profile(sc0, alpha, prof))
-    na = tau_arms.size
-    if na > 0:
-        arms = 0.0
-        for i in range(na):
-            arms += kappa_arms[i] * (H1 - Hf1[i])
-        mem = np.empty(na)
-        t1 = sc0[S_T0] + sc0[S_DT]
-        load = load + arms - _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1,
-                                     alpha, mem)
-    else:
-        load = load + sc0[S_C] * sc0[S_HDOT]
-    q = max(load, 0.0)
-    beta = math.sqrt(alpha * alpha + q * q)  # as edge_zone: numba's hypot rounds otherwise
+def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
+    """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta``, bitwise as
+    ``Step.evaluate`` gives it (the same paths, element ranges and new-element counts).
+    ``sc0``: the step's constants with the lift and its rate set; ``lift``: its path;
+    ``edges``: see ``E_*``; ``n_all`` elements in ``mesh``."""
+    xi = mesh[0]
     paths = np.empty((3, 3))
     _quadratic(edges[E_ALPHA_PREV], edges[E_ALPHA], alpha, edges[E_R], paths[0])
     _quadratic(edges[E_BETA_PREV], edges[E_BETA], beta, edges[E_R], paths[1])
@@ -975,21 +958,57 @@ def receding_gap(alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     return res[R_GAP] - 1.0
 
 
+@njit(cache=True)
+def flat_edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
+    """The zone end the edge condition puts with a flat punch's edge at ``alpha``, as
+    ``contact_phases.edge_zone`` computes it (the same sums, in the same order)."""
+    xi, Y, status, D, tj, t_last = mesh
+    ctil, kappa_arms, tau_arms, V_inv = law
+    Hf1 = stepw[6]
+    H1 = sc0[S_H1]
+    load = sc0[S_KAPPA] * (H1 + _profile(sc0, alpha, prof))
+    na = tau_arms.size
+    if na > 0:
+        arms = 0.0
+        for i in range(na):
+            arms += kappa_arms[i] * (H1 - Hf1[i])
+        mem = np.empty(na)
+        t1 = sc0[S_T0] + sc0[S_DT]
+        load = load + arms - _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1,
+                                     alpha, mem)
+    else:
+        load = load + sc0[S_C] * sc0[S_HDOT]
+    q = max(load, 0.0)
+    return math.sqrt(alpha * alpha + q * q)  # (numba's hypot rounds otherwise)
+
+
+@njit(cache=True)
+def _edge_residual(x, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
+    """The residual a phase's secant searches: a flat punch's receding edge at ``x`` with the
+    zone end from the edge condition (``alpha`` nan), or the zone end at ``x`` with the edge
+    held at ``alpha``."""
+    if math.isnan(alpha):
+        beta = flat_edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
+        return trial_gap(x, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+    return trial_gap(alpha, x, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+
+
 _XTOL = 1e-14
 _STALL = 1e-13
 _SMALL_RESIDUAL = 1e-9
 
 
 @njit(cache=True)
-def receding_secant(x_held, f_held, x_guess, lo, hi, reach, mesh, law, stepw, prof, sc0, edges,
-                    lift, n_all):
-    """``contact_phases._secant`` on :func:`receding_gap`, step for step (the same iterates,
-    brackets and stopping rules; see there): the root, or nan where it gives up."""
+def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw, prof, sc0,
+                edges, lift, n_all):
+    """``contact_phases._secant`` on :func:`_edge_residual` (``alpha``: see there), step for
+    step (the same iterates, brackets and stopping rules): the root, or nan where it gives
+    up."""
     x0, f0 = x_held, f_held
     x1 = min(max(x_guess, lo), hi)
     if x1 == x0:
         return math.nan
-    f1 = receding_gap(x1, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+    f1 = _edge_residual(x1, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
     bracketed, b_lo, b_hi = False, 0.0, 0.0
     slope = math.nan
     for _ in range(40):
@@ -1013,7 +1032,7 @@ def receding_secant(x_held, f_held, x_guess, lo, hi, reach, mesh, law, stepw, pr
             x2 = 0.5 * (b_lo + b_hi)
         if not (lo <= x2 <= hi) or abs(x2 - x_held) > reach:
             return math.nan
-        f2 = receding_gap(x2, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+        f2 = _edge_residual(x2, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
         if bracketed and not math.isnan(f2):
             if (f2 > 0.0) != (f1 > 0.0):
                 b_lo, b_hi = min(x1, x2), max(x1, x2)

@@ -175,7 +175,7 @@ def _Hf(step, H):
 def edge_zone(step, H, alpha):
     """The zone end the edge condition puts with the edge at ``alpha``."""
     Q = max(step.contact_load(alpha, H, step.lift_rate(H), _Hf(step, H)), 0.0)
-    return math.sqrt(alpha * alpha + Q * Q)  # (kernels.contact.receding_gap: the same sum)
+    return math.sqrt(alpha * alpha + Q * Q)  # (kernels.contact.flat_edge_zone: the same sum)
 
 
 def receding(step, H, guess_alpha):
@@ -187,7 +187,7 @@ def receding(step, H, guess_alpha):
 
     r_held = residual(now.alpha)
     alpha = root(residual, now.alpha, r_held, min(guess_alpha, now.alpha), 0.0, now.alpha,
-                 step.jump, step.receding_secant(H) if step.s.setup.flat else None)
+                 step.jump, step.compiled_secant(H))
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
     return step.evaluate(alpha, edge_zone(step, H, alpha), H)
@@ -213,7 +213,7 @@ def zone_end(step, H, alpha, guess_beta, top=math.inf, wide=False):
 
     start = min(max(now.beta, alpha * (1.0 + 1e-12), 1e-12), top)
     beta = root(residual, start, residual(start), min(max(guess_beta, alpha), top), alpha, top,
-                 step.jump or wide)
+                 step.jump or wide, step.compiled_secant(H, alpha))
     if beta is None:
         raise Lost("zone")
     return step.evaluate(alpha, beta, H)

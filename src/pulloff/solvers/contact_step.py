@@ -198,10 +198,16 @@ class Step:
         E = self.filtered_lift(H_new, s_c) + G + self.s.contact_memory_arms(x, t)
         return law.V_inv @ E
 
-    def receding_secant(self, H_new):
-        """``contact_phases._secant`` for a flat punch's receding edge at the lift ``H_new``,
-        compiled (:func:`pulloff.kernels.contact.receding_secant`: the same iterates, without
-        Python between them): ``(x_held, f_held, x_guess, lo, hi, reach) -> root or None``."""
+    def compiled_secant(self, H_new, alpha=None):
+        """``contact_phases._secant`` compiled with its residual at the lift ``H_new``
+        (:func:`pulloff.kernels.contact.edge_secant`: the same iterates, without Python
+        between them): for a flat punch's receding edge (``alpha`` None: the unknown is the
+        edge, the zone end from the edge condition) or for the zone end with the edge held at
+        ``alpha``. ``(x_held, f_held, x_guess, lo, hi, reach) -> root or None``; None where
+        the step places its own elements (an elastic smooth contact: its evaluations are
+        not the compiled ones)."""
+        if self.fresh or (alpha is None and not self.s.setup.flat):
+            return None
         s, now, before = self.s, self.now, self.before
         nodes, law = s.nodes, s.setup.law
         lift, Hdot, Hf = self._end_of(H_new)
@@ -215,10 +221,11 @@ class Step:
         stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf,
                  Hf if law.maxwell else now.Hf)
         table = s.setup.indenter.table
+        held = nan if alpha is None else float(alpha)
 
         def secant(x_held, f_held, x_guess, lo, hi, reach):
-            x = K.receding_secant(x_held, f_held, x_guess, lo, hi, reach, mesh, self.law,
-                                  stepw, table, sc, edges, lift, nodes.n)
+            x = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh, self.law,
+                              stepw, table, sc, edges, lift, nodes.n)
             return None if math.isnan(x) else x
         return secant
 
