@@ -929,7 +929,8 @@ def _quadratic(prev, now, new, r, out):
 @njit(cache=True)
 def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta``, bitwise as
-    ``Step.evaluate`` gives it (the same paths, element ranges and new-element counts).
+    ``Step.evaluate`` gives it (the same paths, element ranges and new-element counts) for a
+    step that is not fresh (``Step.compiled_secant`` refuses those).
     ``sc0``: the step's constants with the lift and its rate set; ``lift``: its path;
     ``edges``: see ``E_*``; ``n_all`` elements in ``mesh``."""
     xi = mesh[0]
@@ -1073,6 +1074,8 @@ def fitted_radau3_rows(mus, out):
 def _rows(new, order, width):
     """``new[order]`` with ``width`` columns (missing ones 0: an elastic element has no
     modes, while the mesh keeps one column)."""
+    if new.shape[1] > width:
+        raise ValueError("new elements have more columns than the mesh")
     out = np.zeros((order.size, width))
     for j in range(order.size):
         for k in range(min(width, new.shape[1])):

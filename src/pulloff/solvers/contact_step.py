@@ -169,8 +169,10 @@ class Step:
                     - memory)
         if law.maxwell:
             memory = self.s.contact_memory(xi, self.now.t + self.dt)
-            return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
-                    - memory)
+            arms = 0.0
+            for kappa, lag in zip(law.kappa_arms.tolist(), (H_new - Hf).tolist()):
+                arms += kappa * lag  # in order, as the compiled edge search sums them
+            return law.kappa_inf * (H_new + G) + arms - memory
         return law.kappa_inf * (H_new + G) + law.c * Hdot
 
     def free_modes_at(self, x):
@@ -203,9 +205,10 @@ class Step:
         (:func:`pulloff.kernels.contact.edge_secant`: the same iterates, without Python
         between them): for a flat punch's receding edge (``alpha`` None: the unknown is the
         edge, the zone end from the edge condition) or for the zone end with the edge held at
-        ``alpha``. ``(x_held, f_held, x_guess, lo, hi, reach) -> root or None``; None where
-        the step places its own elements (an elastic smooth contact: its evaluations are
-        not the compiled ones)."""
+        ``alpha``. ``(x_held, f_held, x_guess, lo, hi, reach) -> root or None``. None (the
+        Python search then) where the step places its own elements (an elastic smooth
+        contact: its evaluations are not the compiled ones) and for a smooth indenter's edge
+        (its contact load is another formula)."""
         if self.fresh or (alpha is None and not self.s.setup.flat):
             return None
         s, now, before = self.s, self.now, self.before

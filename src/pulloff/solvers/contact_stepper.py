@@ -426,14 +426,14 @@ class Stepper:
         now = self.now
         if now.phase != st.CONTACT_PHASE or not self.setup.flat or self.last_dt is None:
             return False
-        driven = self.setup.machine is None
+        driven = self.lift_driven
+        if not driven and self.setup.machine is None:
+            return False  # under force control the end is bisected (its form not measured)
         if horizon is None:
             horizon = 1.0 if driven else 2.0
         t_end = self._vanishes_within(horizon * self.last_dt, 2, 2 if driven else 3)
         if t_end is None or not self._holds(_HOLD_SHARE * (t_end - now.t)):
             return False
-        zone = self._last_quadratic(3)  # the zone end stays smooth: b ~ b_0 + c (t_0 - t)
-        beta = float(np.polyval(zone[1], t_end - zone[0])) if zone else now.beta
         step = self.make_step(t_end - now.t)
         now.phase = st.ZONE
         try:
@@ -442,12 +442,14 @@ class Stepper:
             ev = None
         finally:
             now.phase = st.CONTACT_PHASE
-        if ev is None and self.setup.machine is None:
+        if ev is None and driven:
             return False  # (finite_punch_internal at n = 8: its zone-alone phase; stepped to)
         if ev is None:
             # No zone-alone state balances the spring at a = 0 (measured: the punch lets go
             # there, the reference's "snap_at_a_zero"). The bond's elements go free with
             # their state now; they would relax unloaded for the short landing.
+            zone = self._last_quadratic(3)  # the zone end stays smooth: b ~ b0 + c (t0 - t)
+            beta = float(np.polyval(zone[1], t_end - zone[0])) if zone else now.beta
             self._release_all()
             self._land(t_end, "contact", alpha=0.0, beta=beta, F_contact=0.0,
                        F_total=math.pi * beta ** 2)
