@@ -362,3 +362,24 @@ def test_property_a_batch_of_new_elements_lands_as_one_by_one_inserts_would(old,
     assert batch.n == one.n and batch.xi_max == one.xi_max
     for name in ("xi", "Y", "status", "D", "tj", "t_last"):
         np.testing.assert_array_equal(getattr(batch, name)[:batch.n], getattr(one, name)[:one.n])
+
+
+_COEFFICIENT = st.one_of(st.just(0.0), st.floats(1e-8, 1e8), st.floats(-1e8, -1e-8))
+
+
+@settings(max_examples=300, deadline=None)
+@given(c=st.tuples(_COEFFICIENT, _COEFFICIENT, _COEFFICIENT))
+def test_property_the_rows_quadratic_has_numpys_first_positive_root(c):
+    """contact_stepper._real_roots (the landing on a vanishing edge, every step) against
+    np.roots as the extrapolation took it (imaginary parts below 1e-12 count as real): the
+    first positive root, which is what the landing uses, or none for both. Coefficients
+    of the rows' scales (squared edges and times in units of the run)."""
+    from pulloff.solvers.contact_stepper import _real_roots
+
+    if not any(c):
+        return
+    ours = [r for r in _real_roots(*c) if r > 0.0]
+    theirs = [r.real for r in np.roots(c) if abs(r.imag) < 1e-12 and r.real > 0.0]
+    assert bool(ours) == bool(theirs), (ours, theirs)
+    if ours:
+        assert min(ours) == pytest.approx(min(theirs), rel=1e-9), (ours, theirs)
