@@ -908,10 +908,10 @@ def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha):
 
 
 # --- a phase's edge search, compiled ------------------------------------------------------------
-#: Entries of ``edges`` in :func:`trial_gap`: the edges now and one step earlier (nan after
-#: an event), the earlier step's length in this one's (nan: none), the new elements' spacing
-#: and the step's released-element count.
-E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING, E_K_ALPHA = range(7)
+#: Entries of ``edges`` in :func:`trial_ranges`: the edges now and one step earlier (nan
+#: after an event), the earlier step's length in this one's (nan: none) and the released
+#: elements' spacing.
+E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING = range(6)
 _TINY = 1e-13
 
 
@@ -927,14 +927,12 @@ def _quadratic(prev, now, new, r, out):
 
 
 @njit(cache=True)
-def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
-    """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta``, bitwise as
-    ``Step.evaluate`` gives it (the same paths, element ranges and new-element counts) for a
-    step that is not fresh (``Step.compiled_secant`` refuses those).
-    ``sc0``: the step's constants with the lift and its rate set; ``lift``: its path;
-    ``edges``: see ``E_*``; ``n_all`` elements in ``mesh``."""
-    xi = mesh[0]
-    paths = np.empty((3, 3))
+def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
+    """What a trial step with edges ``alpha``, ``beta`` advances: its paths into ``paths``
+    (the edges' quadratics through the last instants, the lift's ``lift``), the released
+    elements' count in ``sc[S_K_ALPHA]`` widened to the zone's spacing however far the edge
+    recedes (``edges[E_SPACING]`` inf: never), and ``(lo, hi)``, the elements from the edge's
+    lower position to past the zone end's highest (the centre's alone without a zone)."""
     _quadratic(edges[E_ALPHA_PREV], edges[E_ALPHA], alpha, edges[E_R], paths[0])
     _quadratic(edges[E_BETA_PREV], edges[E_BETA], beta, edges[E_R], paths[1])
     paths[2, :] = lift
@@ -946,12 +944,23 @@ def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
         hi = max(np.searchsorted(xs, b_top * (1.0 + 1e-12) + _TINY), lo)
     else:
         hi = lo + 1 if n_all and xi[0] == 0.0 and lo == 0 else lo
-    sc = sc0.copy()
-    k_alpha = int(edges[E_K_ALPHA])
     if alpha < edges[E_ALPHA]:
-        k_alpha = max(k_alpha, int(math.ceil((edges[E_ALPHA] - alpha) / edges[E_SPACING])))
-        sc[S_K_ALPHA] = k_alpha
-    size = (hi - lo) + k_alpha + int(sc[S_K_BETA]) + 1
+        sc[S_K_ALPHA] = max(int(sc[S_K_ALPHA]),
+                            int(math.ceil((edges[E_ALPHA] - alpha) / edges[E_SPACING])))
+    return lo, hi
+
+
+@njit(cache=True)
+def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
+    """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta``, as
+    ``Step.evaluate`` gives it (the same :func:`trial_ranges`) for a step that is not fresh
+    (``Step.compiled_secant`` refuses those). ``sc0``: the step's constants with the lift and
+    its rate set; ``lift``: its path; ``edges``: see ``E_*``; ``n_all`` elements in
+    ``mesh``."""
+    paths = np.empty((3, 3))
+    sc = sc0.copy()
+    lo, hi = trial_ranges(alpha, beta, mesh[0], n_all, edges, lift, paths, sc)
+    size = (hi - lo) + int(sc[S_K_ALPHA]) + int(sc[S_K_BETA]) + 1
     nm = stepw[0].size
     out = (np.empty(size), np.empty((size, nm)), np.empty(size), np.empty(size, dtype=np.int64))
     res = np.empty(R_N)

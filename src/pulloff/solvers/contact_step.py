@@ -19,7 +19,6 @@ import numpy as np
 from ..kernels import contact as K
 from . import contact_state as st
 
-_TINY = 1e-13
 
 
 def quadratic_path(prev, now, new, r):
@@ -96,6 +95,7 @@ class Step:
             drive = stepper.drive
             self._driven = (now.H, drive.rate * dt if drive.kind == "speed" else 0.0, 0.0)
         self._at_end = {}
+        self._edges = None
         # The phase searches come back to points they have evaluated (the held edge, the
         # root they end on): a step answers those from its memo.
         self._memo = {}
@@ -104,6 +104,18 @@ class Step:
         sc[K.S_T0], sc[K.S_DT], sc[K.S_ALPHA0], sc[K.S_BETA0] = now.t, dt, now.alpha, now.beta
         sc[K.S_XIMAX], sc[K.S_KINK] = stepper.nodes.xi_max, stepper.first_edge
         self._constants = sc
+
+    @property
+    def edges(self) -> np.ndarray:
+        """The edges now and one step earlier, the steps' ratio and the released elements'
+        spacing (inf where the step places its own): ``kernels.contact.trial_ranges``'s."""
+        if self._edges is None:
+            now, before, nan = self.now, self.before, math.nan
+            self._edges = np.array([
+                now.alpha, now.beta, before.alpha if before is not None else nan,
+                before.beta if before is not None else nan, nan if self.r is None else self.r,
+                math.inf if self.fresh else self.s.spacing(now)])
+        return self._edges
 
     @property
     def constants(self):
@@ -216,15 +228,12 @@ class Step:
         lift, Hdot, Hf = self._end_of(H_new)
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
-        nan = math.nan
-        edges = np.array([now.alpha, now.beta, before.alpha if before is not None else nan,
-                          before.beta if before is not None else nan,
-                          nan if self.r is None else self.r, s.spacing(now), self.k_alpha])
+        edges = self.edges
         mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
         stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf,
                  Hf if law.maxwell else now.Hf)
         table = s.setup.indenter.table
-        held = nan if alpha is None else float(alpha)
+        held = math.nan if alpha is None else float(alpha)
 
         def secant(x_held, f_held, x_guess, lo, hi, reach):
             x = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh, self.law,
@@ -250,28 +259,13 @@ class Step:
         lift, Hdot, Hf = self._end_of(H_new)
         if not law.maxwell:
             Hf = now.Hf
-        zone = beta > 0.0
-        bp = self.path("beta", beta)
-        b_top = max(now.beta, beta, bp[0] + 0.5 * (bp[1] + 0.5 * bp[2])) if zone else 0.0
-        lo = nodes.below(min(now.alpha, alpha) - _TINY)
-        if zone:
-            hi = max(nodes.below(b_top * (1.0 + 1e-12) + _TINY), lo)
-        else:  # no zone: only the element at the centre matters (its gap)
-            hi = lo + 1 if nodes.n and nodes.xi[0] == 0.0 and lo == 0 else lo
-        paths = np.empty((3, 3))
-        paths[0] = self.path("alpha", alpha)
-        paths[1] = bp
-        paths[2] = lift
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+        paths = np.empty((3, 3))
+        lo, hi = K.trial_ranges(alpha, beta, nodes.xi, nodes.n, self.edges, lift, paths, sc)
         if self.fresh:
             lo = hi = 0
-        k_alpha = self.k_alpha
-        if alpha < now.alpha and not self.fresh:
-            # However far this trial recedes, the released stretch gets the zone's spacing.
-            k_alpha = max(k_alpha, int(math.ceil((now.alpha - alpha) / s.spacing(now))))
-            sc[K.S_K_ALPHA] = k_alpha
-        size = (hi - lo) + k_alpha + int(sc[K.S_K_BETA]) + 1
+        size = (hi - lo) + int(sc[K.S_K_ALPHA]) + int(sc[K.S_K_BETA]) + 1
         nm = self.mus.size
         out = (np.empty(size), np.empty((size, nm)), np.empty(size),
                np.empty(size, dtype=np.int64))
