@@ -40,7 +40,7 @@ MARCH_STEPS = [100, 300, 1_000, 3_000, 10_000]
 RTOLS = [10.0**-e for e in np.arange(3.0, 9.01, 0.5)]
 STEPS = [100 * 2**j for j in range(8)]  # 100 .. 12800
 SCENE = (1.0, 1e-4)  # alpha, chi
-CONTACT_CONFIGS = ("separation_kv", "sls_finite_punch")
+CONTACT_CONFIGS = ("separation_kv", "sls_finite_punch", "seed_flat_punch")
 CONTACT_LEVELS = [16, 32, 64, 128, 256]
 MIN_REPEATS = 15  # samples per point, enough for a meaningful interquartile range
 MIN_TOTAL = 0.3  # s per point
@@ -338,17 +338,19 @@ def report_run_foundation(problem: Problem):
 
 
 def contact_level(scene, n):
-    """``(seconds, steps, evaluations, element-evaluations, elements at the end)`` of one
-    warm level of the moving-edge stepper; every trial evaluation is counted by wrapping
+    """``(seconds, steps, evaluations, element-evaluations, elements at the end, most live
+    elements)`` of one warm level of the moving-edge stepper (live: not archived behind a
+    receding zone); every trial evaluation is counted by wrapping
     :meth:`pulloff.solvers.contact_step.Step._evaluate` for the duration."""
     from pulloff.solvers import contact, contact_step
 
-    counted = []
+    counted, live = [], [0]
     original = contact_step.Step._evaluate
 
     def counting(self, alpha, beta, H_new):
         ev = original(self, alpha, beta, H_new)
         counted.append(len(ev.xi))
+        live[0] = max(live[0], self.s.nodes.n)
         return ev
 
     contact_step.Step._evaluate = counting
@@ -358,7 +360,8 @@ def contact_level(scene, n):
         seconds = time.perf_counter() - start
     finally:
         contact_step.Step._evaluate = original
-    return seconds, len(level.rows) - 1, len(counted), sum(counted), level.nodes.n
+    return (seconds, len(level.rows) - 1, len(counted), sum(counted), level.nodes.total,
+            live[0])
 
 
 def report_contact():
@@ -369,23 +372,25 @@ def report_contact():
 
     out("\n== moving-edge (contact) stepper: one warm level per n, to separation")
     out(f"  {'config':<18} {'n':>5} {'steps':>6} {'evals':>7} {'elem-evals':>11} "
-        f"{'elements':>9} {'s':>8} {'ns/elem-eval':>13}")
+        f"{'elements':>9} {'live':>6} {'s':>8} {'ns/elem-eval':>13}")
     for config in CONTACT_CONFIGS:
-        scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / f"{config}.yaml")
+        scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / f"{config}.yaml",
+                           overrides=["model.until=separation"])
         contact.run_level(scene, CONTACT_LEVELS[0])  # compile / warm
         rows = [contact_level(scene, n) for n in CONTACT_LEVELS]
-        for n, (sec, steps, evals, work, elements) in zip(CONTACT_LEVELS, rows):
+        for n, (sec, steps, evals, work, elements, live) in zip(CONTACT_LEVELS, rows):
             out(f"  {config:<18} {n:5d} {steps:6d} {evals:7d} {work:11.3g} {elements:9d} "
-                f"{sec:8.3f} {1e9 * sec / work:13.0f}")
+                f"{live:6d} {sec:8.3f} {1e9 * sec / work:13.0f}")
         secs = [r[0] for r in rows]
         steps = [r[1] for r in rows]
         p_work = loglog_slope([r[3] for r in rows], secs)
         p_steps = loglog_slope(steps, secs)
         p_top = loglog_slope(steps[-2:], secs[-2:])
         p_elements = loglog_slope(steps, [r[4] for r in rows])
+        p_live = loglog_slope(steps, [r[5] for r in rows])
         out(f"  {config}: time ~ element-evaluations^{p_work:.2f}; ~ steps^{p_steps:.2f} over "
-            f"all, ^{p_top:.2f} over the top two; elements ~ steps^{p_elements:.2f} (the "
-            f"target: time ~ steps^1, elements bounded)")
+            f"all, ^{p_top:.2f} over the top two; elements ~ steps^{p_elements:.2f}, live "
+            f"~ steps^{p_live:.2f} (the target: time ~ steps^1, elements bounded)")
 
 
 def main() -> None:

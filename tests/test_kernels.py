@@ -364,6 +364,38 @@ def test_property_a_batch_of_new_elements_lands_as_one_by_one_inserts_would(old,
         np.testing.assert_array_equal(getattr(batch, name)[:batch.n], getattr(one, name)[:one.n])
 
 
+@settings(max_examples=100, deadline=None)
+@given(old=st.lists(st.floats(0.0, 2.0), min_size=1, max_size=40, unique=True),
+       cut=st.floats(0.0, 2.0), at_least=st.integers(0, 8),
+       new=st.lists(st.floats(0.0, 3.0), min_size=1, max_size=12, unique=True))
+def test_property_archived_elements_come_back_as_they_left(old, cut, at_least, new):
+    """contact_state.Nodes: the free elements beyond ``cut`` archived (if there are at least
+    ``at_least``), then new ones inserted, some beyond the archived ones: the mesh is the one
+    that never archived, every column carried along, and nothing is lost on the way."""
+    from pulloff.solvers.contact_state import FREE, Nodes
+
+    new = [x for x in new if x not in old]
+    kept, archived = Nodes(2, 1, capacity=4), Nodes(2, 1, capacity=4)
+    for k, x in enumerate(sorted(old)):
+        for nodes in (kept, archived):
+            nodes.insert(x, np.array([x, -x]), FREE, np.array([k]), tj=0.5, t_last=0.25 * k)
+    moved = archived.archive_beyond(cut, at_least)
+    beyond = sum(x >= cut for x in old)
+    assert moved == (beyond if beyond >= max(at_least, 1) else 0)
+    assert archived.n == len(old) - moved and archived.total == len(old)
+    assert archived.live_end == (min(x for x in old if x >= cut) if moved else math.inf)
+    for x in new:
+        for nodes in (kept, archived):
+            nodes.insert(float(x), np.array([2 * x, 3 * x]), FREE, np.array([7 * x]), tj=1.5,
+                         t_last=1.0)
+    assert archived.total == kept.total == kept.n
+    archived.restore()
+    assert archived.n == kept.n and archived.live_end == math.inf
+    for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+        np.testing.assert_array_equal(getattr(archived, name)[:archived.n],
+                                      getattr(kept, name)[:kept.n])
+
+
 _COEFFICIENT = st.one_of(st.just(0.0), st.floats(1e-8, 1e8), st.floats(-1e8, -1e-8))
 
 

@@ -406,9 +406,50 @@ def test_a_growing_zone_is_thinned_and_the_onset_keeps_its_digits(monkeypatch, c
     thinned = contact.run_level(scene, 64)
     monkeypatch.setattr(contact_replay, "GROWING", ())
     unthinned = contact.run_level(scene, 64)
-    assert thinned.nodes.n < 0.6 * unthinned.nodes.n
+    assert thinned.nodes.total < 0.6 * unthinned.nodes.total
     for name in ("t_detach", "F_total_detach"):
         assert thinned.summary[name] == pytest.approx(unthinned.summary[name], rel=1e-9)
+
+
+def _rows(level):
+    return np.array([[float(v) if isinstance(v, (int, float)) else np.nan for v in row]
+                     for row in level.rows])
+
+
+def test_a_receding_zone_archives_what_it_leaves_behind_and_the_rows_do_not_change(
+        monkeypatch):
+    """contact_state.Nodes.archive_beyond: seed_flat_punch at n = 32 leaves ~10^4 elements
+    behind its receding zone; archived, a step's work no longer shifts them (the live mesh is
+    a few hundred at most), and every row is bitwise as without the archive. Archiving right at the
+    zone end (every element, no margin) makes trials reach the archive: the archived
+    elements come back before those evaluations, and the rows are still bitwise the same."""
+    seed = load_scene(CONFIGS / "seed_flat_punch.yaml", overrides=["model.until=separation"])
+    archived = contact.run_level(seed, 32)
+    monkeypatch.setattr(contact_stepper, "ARCHIVE_AT", 10**9)
+    kept = contact.run_level(seed, 32)
+    assert kept.nodes.n == kept.nodes.total > 5000
+    assert archived.nodes.total == kept.nodes.total and archived.nodes.n < 0.05 * kept.nodes.n
+    np.testing.assert_array_equal(_rows(archived), _rows(kept))
+
+    restores = []
+    restore = contact_state.Nodes.restore
+
+    def counted(nodes):
+        restores.append(nodes.total - nodes.n)
+        restore(nodes)
+
+    monkeypatch.setattr(contact_state.Nodes, "restore", counted)
+    for config, overrides in (("separation_kv.yaml", []),
+                              ("sls_finite_punch.yaml", ["geometry.cohesive_zone=external"])):
+        scene = load_scene(CONFIGS / config, overrides=["model.until=separation"] + overrides)
+        monkeypatch.setattr(contact_stepper, "ARCHIVE_AT", 10**9)
+        kept = contact.run_level(scene, 16)
+        monkeypatch.setattr(contact_stepper, "ARCHIVE_AT", 1)
+        monkeypatch.setattr(contact_stepper, "ARCHIVE_WIDTHS", 0.0)
+        restores.clear()
+        archived = contact.run_level(scene, 16)
+        assert sum(moved > 0 for moved in restores) >= 5, restores
+        np.testing.assert_array_equal(_rows(archived), _rows(kept))
 
 
 def test_behind_a_spring_past_the_onset_a_kelvin_voigt_zone_is_neither_thinned_nor_folded(
@@ -424,7 +465,7 @@ def test_behind_a_spring_past_the_onset_a_kelvin_voigt_zone_is_neither_thinned_n
     level = contact.run_level(scene, 32)
     monkeypatch.setattr(contact_replay, "GROWING", ())
     unthinned = contact.run_level(scene, 32)
-    assert level.nodes.n == unthinned.nodes.n
+    assert level.nodes.total == unthinned.nodes.total
     assert level.summary["t_separation"] == unthinned.summary["t_separation"]
     for config, foldable in (("compliant_machine.yaml", False),
                              ("sls_finite_punch.yaml", True)):

@@ -571,8 +571,9 @@ def _split_integral(th, f, m, s, th_kink):
 #: Indices of the scalar results of :func:`evaluate_step`.
 R_GAP, R_EDGE_LOAD, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(6)
 #: Indices of the step constants ``sc`` of :func:`evaluate_step`.
+#: ``S_LIVE_END``: the nearest archived element (inf: none; see ``contact_state.Nodes``).
 (S_T0, S_DT, S_ALPHA0, S_BETA0, S_H1, S_HDOT, S_XIMAX, S_KAPPA, S_C, S_D, S_FLAT, S_AF, S_C_G,
- S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH, S_KINK) = range(18)
+ S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH, S_KINK, S_LIVE_END, S_N) = range(20)
 
 
 @njit(cache=True)
@@ -661,8 +662,9 @@ def _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, x, out):
             continue
         if xi[j] <= x:
             left = j
-        elif right < 0:
+        else:  # sorted: the first contact element beyond x ends the search
             right = j
+            break
     if left < 0 and right < 0:
         return 0.0
     total = 0.0
@@ -889,7 +891,9 @@ def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha):
     x_prev, v_prev = 0.0, math.nan
     mem = np.empty(tau_arms.size)
     for j in range(n_all):
-        if status[j] != 1 or xi[j] >= alpha:
+        if xi[j] >= alpha:  # sorted: none further lies inside
+            break
+        if status[j] != 1:
             continue
         v = 0.0
         for i in range(tau_arms.size):
@@ -932,7 +936,9 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     (the edges' quadratics through the last instants, the lift's ``lift``), the released
     elements' count in ``sc[S_K_ALPHA]`` widened to the zone's spacing however far the edge
     recedes (``edges[E_SPACING]`` inf: never), and ``(lo, hi)``, the elements from the edge's
-    lower position to past the zone end's highest (the centre's alone without a zone)."""
+    lower position to past the zone end's highest (the centre's alone without a zone);
+    ``hi`` is -1 where that reaches the archived elements (``sc[S_LIVE_END]``): they must
+    come back first."""
     _quadratic(edges[E_ALPHA_PREV], edges[E_ALPHA], alpha, edges[E_R], paths[0])
     _quadratic(edges[E_BETA_PREV], edges[E_BETA], beta, edges[E_R], paths[1])
     paths[2, :] = lift
@@ -941,6 +947,8 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     lo = np.searchsorted(xs, min(edges[E_ALPHA], alpha) - _TINY)
     if beta > 0.0:
         b_top = max(edges[E_BETA], beta, bp[0] + 0.5 * (bp[1] + 0.5 * bp[2]))
+        if b_top * (1.0 + 1e-12) + _TINY >= sc[S_LIVE_END]:
+            return lo, -1
         hi = max(np.searchsorted(xs, b_top * (1.0 + 1e-12) + _TINY), lo)
     else:
         hi = lo + 1 if n_all and xi[0] == 0.0 and lo == 0 else lo
@@ -960,6 +968,8 @@ def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     paths = np.empty((3, 3))
     sc = sc0.copy()
     lo, hi = trial_ranges(alpha, beta, mesh[0], n_all, edges, lift, paths, sc)
+    if hi < 0:  # the archived elements are needed: the Python search brings them back
+        return math.nan
     size = (hi - lo) + int(sc[S_K_ALPHA]) + int(sc[S_K_BETA]) + 1
     nm = stepw[0].size
     out = (np.empty(size), np.empty((size, nm)), np.empty(size), np.empty(size, dtype=np.int64))

@@ -331,7 +331,7 @@ def _result(scene, setup, ladder_result, observers, wall) -> Result:
     else:
         summary.update(_path_groups(scene))
     summary.update(error_estimate=float(estimate), observed_order=float(ladder_result.order),
-                   n_elements=int(finest.nodes.n), n_steps=len(finest.rows) - 1,
+                   n_elements=int(finest.nodes.total), n_steps=len(finest.rows) - 1,
                    wall_time=wall, t_end=float(finest.now.t * setup.T), solver="contact",
                    history=scene.model.history, until=setup.until,
                    cohesive_zone=getattr(scene.geometry, "cohesive_zone", ""))

@@ -21,14 +21,25 @@ APART = "apart"  # no zone: the surfaces are further apart than delta
 DONE = "done"
 
 
+COLUMNS = ("xi", "Y", "status", "D", "tj", "t_last")
+
+
 class Nodes:
     """Foundation elements sorted by position ``xi``: the modes ``Y`` of a free element (valid
     at ``t_last``; elements beyond the zone relax unloaded and are brought up to date only
     when the zone reaches them), and for an element in contact the memory ``D`` of its arms
-    at the time ``tj`` it joined (see :meth:`pulloff.solvers.contact.Stepper.contact_arms`)."""
+    at the time ``tj`` it joined (see :meth:`pulloff.solvers.contact.Stepper.contact_arms`).
+
+    The first ``n`` are live. Free elements a receding zone left behind may be archived
+    (:meth:`archive_beyond`): untouched until a zone reaches them again, they would
+    otherwise be shifted by every insertion in front of them (seed_flat_punch leaves tens of
+    thousands behind). A trial that reaches ``live_end`` brings them back first
+    (:meth:`restore`)."""
 
     def __init__(self, n_modes: int, n_arms: int, capacity: int = 256):
         self.n = 0
+        self._archive = []  # blocks of archived columns, the nearest last
+        self.live_end = math.inf  # the nearest archived element
         self.xi = np.zeros(capacity)
         self.Y = np.zeros((capacity, max(n_modes, 1)))
         self.status = np.zeros(capacity, dtype=np.int64)
@@ -38,19 +49,49 @@ class Nodes:
         self.xi_max = -math.inf  # the furthest any element ever was: beyond, the solid is virgin
 
     def _grow(self):
-        for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+        for name in COLUMNS:
             old = getattr(self, name)
             new = np.zeros((2 * old.shape[0],) + old.shape[1:], dtype=old.dtype)
             new[:self.n] = old[:self.n]
             setattr(self, name, new)
 
+    @property
+    def total(self) -> int:
+        """Elements live and archived."""
+        return self.n + sum(block[0].size for block in self._archive)
+
+    def archive_beyond(self, x: float, at_least: int) -> int:
+        """Archive the live elements beyond ``x`` if there are at least ``at_least`` (and
+        none is in contact); returns how many went."""
+        k = self.below(x)
+        if self.n - k < max(at_least, 1) or np.any(self.status[k:self.n] != FREE):
+            return 0
+        self._archive.append(tuple(getattr(self, name)[k:self.n].copy() for name in COLUMNS))
+        moved = self.n - k
+        self.n = k
+        self.live_end = float(self._archive[-1][0][0])
+        return moved
+
+    def restore(self) -> None:
+        """Every archived element live again, in place (they lie beyond the live ones)."""
+        while self._archive:
+            block = self._archive.pop()
+            while self.n + block[0].size > self.xi.shape[0]:
+                self._grow()
+            for name, column in zip(COLUMNS, block):
+                getattr(self, name)[self.n:self.n + column.shape[0]] = column
+            self.n += block[0].size
+        self.live_end = math.inf
+
     def insert(self, x: float, Y=None, status: int = FREE, D=None, tj: float = 0.0,
                t_last: float = 0.0) -> int:
         """Put an element at ``x`` (kept sorted); returns its index."""
+        if x >= self.live_end:
+            self.restore()
         if self.n == self.xi.shape[0]:
             self._grow()
         i = int(np.searchsorted(self.xi[:self.n], x))
-        for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+        for name in COLUMNS:
             arr = getattr(self, name)
             arr[i + 1:self.n + 1] = arr[i:self.n]
         self.xi[i] = x
@@ -71,6 +112,8 @@ class Nodes:
         a third of the run went into those shifts)."""
         if x.size == 0:
             return
+        if np.max(x) >= self.live_end:
+            self.restore()
         while self.n + x.size > self.xi.shape[0]:
             self._grow()
         insert_batch((self.xi, self.Y, self.status, self.D, self.tj, self.t_last), self.n,
@@ -87,7 +130,7 @@ class Nodes:
         keep = np.ones(self.n, dtype=bool)
         keep[drop] = False
         k = int(keep.sum())
-        for name in ("xi", "Y", "status", "D", "tj", "t_last"):
+        for name in COLUMNS:
             arr = getattr(self, name)
             arr[:k] = arr[:self.n][keep]
         self.n = k

@@ -60,7 +60,7 @@ def step_constants(setup) -> np.ndarray:
     """The constants ``sc`` (:func:`pulloff.kernels.contact.evaluate_step`) every step of
     ``setup`` shares, the law's and the indenter's; a step copies them and adds its own."""
     law, ind = setup.law, setup.indenter
-    sc = np.zeros(18)
+    sc = np.zeros(K.S_N)
     sc[[K.S_KAPPA, K.S_C, K.S_D, K.S_FLAT, K.S_AF, K.S_C_G, K.S_N_G, K.S_FRESH]] = (
         law.kappa_inf, law.c, law.d, 1.0 if setup.flat else 0.0, ind.A_f, ind.C, ind.n,
         1.0 if is_fresh(setup) else 0.0)
@@ -103,6 +103,7 @@ class Step:
         sc = stepper.step_constants.copy()
         sc[K.S_T0], sc[K.S_DT], sc[K.S_ALPHA0], sc[K.S_BETA0] = now.t, dt, now.alpha, now.beta
         sc[K.S_XIMAX], sc[K.S_KINK] = stepper.nodes.xi_max, stepper.first_edge
+        sc[K.S_LIVE_END] = stepper.nodes.live_end
         self._constants = sc
 
     @property
@@ -229,13 +230,16 @@ class Step:
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         edges = self.edges
-        mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
         stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf,
                  Hf if law.maxwell else now.Hf)
         table = s.setup.indenter.table
         held = math.nan if alpha is None else float(alpha)
 
         def secant(x_held, f_held, x_guess, lo, hi, reach):
+            # (the mesh as it is now: a Python evaluation may have brought archived elements
+            # back since)
+            mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            sc[K.S_LIVE_END] = nodes.live_end
             x = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh, self.law,
                               stepw, table, sc, edges, lift, nodes.n)
             return None if math.isnan(x) else x
@@ -263,6 +267,10 @@ class Step:
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         paths = np.empty((3, 3))
         lo, hi = K.trial_ranges(alpha, beta, nodes.xi, nodes.n, self.edges, lift, paths, sc)
+        if hi < 0:  # the trial reaches the archived elements: every element is live again
+            nodes.restore()
+            self._constants[K.S_LIVE_END] = sc[K.S_LIVE_END] = nodes.live_end
+            lo, hi = K.trial_ranges(alpha, beta, nodes.xi, nodes.n, self.edges, lift, paths, sc)
         if self.fresh:
             lo = hi = 0
         size = (hi - lo) + int(sc[K.S_K_ALPHA]) + int(sc[K.S_K_BETA]) + 1

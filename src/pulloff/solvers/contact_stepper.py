@@ -69,6 +69,11 @@ FORCE_RANGE = 1.0
 BALANCED_FORCE_RANGE = 1e-3
 #: A zone extrapolated to vanish must still hold this share of the way to its end.
 _HOLD_SHARE = 0.9
+#: A receding flat punch's zone archives the elements it left behind beyond this many zone
+#: widths past its end (and 1e-3 of the end), once there are ARCHIVE_AT of them: a trial that
+#: reaches them brings them back (a step moves the end by a small share of that).
+ARCHIVE_WIDTHS = 2.0
+ARCHIVE_AT = 256
 
 
 def _real_roots(c2, c1, c0) -> list:
@@ -747,6 +752,15 @@ class Stepper:
         self._row(self.now)
         replay.refine(self)
         replay.thin(self)
+        self._archive_behind()
+
+    def _archive_behind(self) -> None:
+        """A flat punch's zone end receding archives what it leaves behind (``Nodes``)."""
+        now, before = self.now, self.before
+        if not self.setup.flat or now.beta <= 0.0 or now.beta >= before.beta:
+            return
+        cut = now.beta * (1.0 + 1e-3) + ARCHIVE_WIDTHS * (now.beta - now.alpha)
+        self.nodes.archive_beyond(cut, ARCHIVE_AT)
 
     def _insert_new(self, ev, t1) -> None:
         """The step's new elements join the mesh. One new in the step and already inside the
