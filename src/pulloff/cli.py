@@ -107,8 +107,9 @@ def _compile_notice(args) -> None:
     from .kernels import cache_is_warm
 
     if not getattr(args, "quiet", False) and not cache_is_warm():
-        print("pulloff: compiling the numba kernels for this machine (first run only, "
-              "10-15 s)", file=sys.stderr, flush=True)
+        print("pulloff: compiling the numba kernels for this machine (first run only: "
+              "~10 s for an onset, up to a minute for a moving contact edge)",
+              file=sys.stderr, flush=True)
 
 
 def _show_progress(args) -> bool:
