@@ -162,3 +162,44 @@ def test_extrapolations_that_stop_changing_keep_the_previous_change_as_estimate(
         v.append(np.array([(3.0 * (1.0 + err) + v[-1][0]) / 4.0]))
     _, estimate = levels.extrapolate(v, ORDER)
     assert estimate > 1e-8
+
+
+def _richardson_as_arrays(values, order, floor):
+    """levels.richardson's rule stated over whole arrays (its form before it ran over Python
+    floats): the reference the float form must reproduce bit for bit."""
+    v0, v1, v2 = (np.asarray(v, dtype=float) for v in values)
+    nan = np.isnan(np.array([v0, v1, v2]))
+    if not np.all(nan == nan[-1]):
+        return math.inf, math.nan
+    scale = np.maximum(np.abs(v2), 0.0 if floor is None else np.asarray(floor, dtype=float))
+    mask = np.isfinite(v2) & (scale != 0) & np.isfinite(v1) & np.isfinite(v0)
+    if not np.any(mask):
+        return 0.0, math.nan
+    d_last = np.abs(v2 - v1)[mask] / scale[mask]
+    d_prev = np.abs(v1 - v0)[mask] / scale[mask]
+    worst = int(np.argmax(d_last))
+    if d_last[worst] == 0.0:
+        return 0.0, math.nan
+    measured = math.log2(d_prev[worst] / d_last[worst]) if d_prev[worst] > 0 else order.high
+    if measured < levels.DIVERGING_ORDER:
+        return float(max(d_last[worst], d_prev[worst])), measured
+    p = min(order.high, max(order.low, measured))
+    return float(d_last[worst] / (2.0 ** p - 1.0)), measured
+
+
+_OUTPUT = st.one_of(st.just(math.nan), st.just(0.0), st.floats(-1e3, 1e3, allow_nan=False))
+
+
+@settings(max_examples=300, deadline=None)
+@given(k=st.integers(1, 6), data=st.data(), with_floor=st.booleans())
+def test_property_richardson_over_floats_is_its_array_form_bit_for_bit(k, data, with_floor):
+    """The ladder's estimate runs over Python floats (the array calls cost ~0.5 ms of a
+    ~2.5 ms onset run at rtol 1e-6): same estimate and order as the array form, nan, zero
+    and ties included."""
+    values = [np.array(data.draw(st.lists(_OUTPUT, min_size=k, max_size=k))) for _ in range(3)]
+    floor = (np.array(data.draw(st.lists(st.floats(0.0, 10.0), min_size=k, max_size=k)))
+             if with_floor else None)
+    order = levels.Order(1.0, 2.0)
+    got = levels.richardson(values, order, floor)
+    want = _richardson_as_arrays(values, order, floor)
+    assert [repr(x) for x in got] == [repr(x) for x in want]
