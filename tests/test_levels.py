@@ -175,8 +175,9 @@ def _richardson_as_arrays(values, order, floor):
     mask = np.isfinite(v2) & (scale != 0) & np.isfinite(v1) & np.isfinite(v0)
     if not np.any(mask):
         return 0.0, math.nan
-    d_last = np.abs(v2 - v1)[mask] / scale[mask]
-    d_prev = np.abs(v1 - v0)[mask] / scale[mask]
+    with np.errstate(over="ignore"):  # (a subnormal floor: inf, as Python floats give)
+        d_last = np.abs(v2 - v1)[mask] / scale[mask]
+        d_prev = np.abs(v1 - v0)[mask] / scale[mask]
     worst = int(np.argmax(d_last))
     if d_last[worst] == 0.0:
         return 0.0, math.nan
