@@ -411,11 +411,6 @@ def test_a_growing_zone_is_thinned_and_the_onset_keeps_its_digits(monkeypatch, c
         assert thinned.summary[name] == pytest.approx(unthinned.summary[name], rel=1e-9)
 
 
-def _rows(level):
-    return np.array([[float(v) if isinstance(v, (int, float)) else np.nan for v in row]
-                     for row in level.rows])
-
-
 def test_a_receding_zone_archives_what_it_leaves_behind_and_the_rows_do_not_change(
         monkeypatch):
     """contact_state.Nodes.archive_beyond: seed_flat_punch at n = 32 leaves ~10^4 elements
@@ -429,7 +424,7 @@ def test_a_receding_zone_archives_what_it_leaves_behind_and_the_rows_do_not_chan
     kept = contact.run_level(seed, 32)
     assert kept.nodes.n == kept.nodes.total > 5000
     assert archived.nodes.total == kept.nodes.total and archived.nodes.n < 0.05 * kept.nodes.n
-    np.testing.assert_array_equal(_rows(archived), _rows(kept))
+    np.testing.assert_array_equal(np.array(archived.rows), np.array(kept.rows))
 
     restores = []
     restore = contact_state.Nodes.restore
@@ -449,7 +444,7 @@ def test_a_receding_zone_archives_what_it_leaves_behind_and_the_rows_do_not_chan
         restores.clear()
         archived = contact.run_level(scene, 16)
         assert sum(moved > 0 for moved in restores) >= 5, restores
-        np.testing.assert_array_equal(_rows(archived), _rows(kept))
+        np.testing.assert_array_equal(np.array(archived.rows), np.array(kept.rows))
 
 
 def test_behind_a_spring_past_the_onset_a_kelvin_voigt_zone_is_neither_thinned_nor_folded(
