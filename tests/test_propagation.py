@@ -669,3 +669,49 @@ def test_a_receding_bond_under_a_driven_lift_is_landed_on_a_zero(monkeypatch):
     assert end(landed) == pytest.approx(end(stepped), rel=1e-8)
     assert landed.summary["t_separation"] == pytest.approx(stepped.summary["t_separation"],
                                                            rel=1e-6)
+
+
+@pytest.mark.parametrize("config, overrides", [
+    ("sls_finite_punch.yaml", []),  # arms: new elements inside the contact need their memory
+    ("separation_kv.yaml", []),
+    ("prony_external.yaml", []),
+    ("sphere_sls_cycle.yaml", []),  # a smooth indenter's edge elements stay in Python
+])
+def test_a_step_committed_compiled_leaves_the_mesh_and_rows_as_the_python_commit(
+        monkeypatch, config, overrides):
+    """Stepper._commit_plain (kernels.contact.commit_plain) against the Python commit it
+    shortcuts (releases, captures, new elements, arms' memory on joining): every row and
+    every element column bitwise equal at the end, with most steps committed compiled."""
+    until = [] if "sphere" in config else ["model.until=separation"]
+    scene = load_scene(CONFIGS / config, overrides=until + overrides)
+    plain = contact_stepper.Stepper._commit_plain
+    taken = []
+
+    def counted(stepper, ev, t1):
+        taken.append(plain(stepper, ev, t1))
+        return taken[-1]
+
+    monkeypatch.setattr(contact_stepper.Stepper, "_commit_plain", counted)
+    compiled = contact.run_level(scene, 16)
+    # (a sphere's advancing edge captures free elements in about half its steps: Python's)
+    assert sum(taken) >= 0.4 * len(taken), (sum(taken), len(taken))
+    monkeypatch.setattr(contact_stepper.Stepper, "_commit_plain", lambda *args: False)
+    python = contact.run_level(scene, 16)
+    np.testing.assert_array_equal(np.array(compiled.rows), np.array(python.rows))
+    for name in contact_state.COLUMNS:
+        np.testing.assert_array_equal(getattr(compiled.nodes, name)[:compiled.nodes.n],
+                                      getattr(python.nodes, name)[:python.nodes.n])
+
+
+def test_an_instant_copies_with_its_changes_and_its_own_filtered_lift():
+    """contact_state.Instant.copy (every step): the changes applied, the rest kept, ``Hf``
+    not shared, and a misspelt field refused as dataclasses.replace refuses it."""
+    now = contact_state.Instant(1.0, 2.0, 0.5, 0.9, 1.1, contact_state.PINNED,
+                                Hf=np.array([0.25, 0.5]))
+    later = now.copy(t=1.5, beta=1.2)
+    assert (later.t, later.H, later.alpha, later.beta, later.phase) == (
+        1.5, 2.0, 0.9, 1.2, contact_state.PINNED)
+    later.Hf[0] = 7.0
+    assert now.Hf[0] == 0.25 and now.t == 1.0
+    with pytest.raises(TypeError, match="betta"):
+        now.copy(betta=1.0)

@@ -1117,3 +1117,59 @@ def insert_batch(mesh, n, x, Y, status, D, tj, t_last):
     merge_sorted(D_m, n, at, _rows(D, order, D_m.shape[1]))
     merge_sorted(tj_m, n, at, tj[order])
     merge_sorted(t_last_m, n, at, np.full(x.size, t_last))
+
+
+@njit(cache=True)
+def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthest):
+    """A step's end into the mesh when nothing needs the Python path (no free element captured
+    by the edge, no new element beyond ``live_end``, room for the new ones): every advanced
+    element ``lo..hi-1`` takes its row of ``Y_ev`` (the evaluation's rows with ``flags`` 1 are
+    new), is valid at ``t1`` and is freed beyond ``alpha``; the new ones are merged in, in
+    contact (joined at ``t1``) inside ``alpha``. Returns how many were inserted and the mesh
+    indices of those inside ``alpha`` (their arms' memory is the caller's), or -1 with
+    nothing changed; ``furthest[0]`` the furthest new one."""
+    xi_m, Y_m, status_m, D_m, tj_m, t_last_m = mesh
+    m = x_ev.size
+    none = np.empty(0, dtype=np.int64)
+    if Y_ev.shape[1] != Y_m.shape[1]:
+        return -1, none
+    k_new = 0
+    for j in range(m):
+        if flags[j] == 1:
+            if x_ev[j] >= live_end:
+                return -1, none
+            k_new += 1
+    if m - k_new != hi - lo or n + k_new > xi_m.size:
+        return -1, none
+    if alpha > 0.0:
+        for i in range(lo, hi):
+            if status_m[i] == 0 and xi_m[i] <= alpha:
+                return -1, none
+    i = lo
+    for j in range(m):
+        if flags[j] == 1:
+            continue
+        for k in range(Y_ev.shape[1]):
+            Y_m[i, k] = Y_ev[j, k]
+        t_last_m[i] = t1
+        if status_m[i] == 1 and xi_m[i] > alpha:
+            status_m[i] = 0
+        i += 1
+    if k_new == 0:
+        return 0, none
+    new = np.nonzero(flags == 1)[0]
+    xs = x_ev[new]
+    inside = (xs > 0.0) & (xs <= alpha)
+    furthest[0] = np.max(xs)
+    # Where insert_batch puts each (its stable order, before old rows at equal x).
+    order = np.argsort(xs, kind="mergesort")
+    at = np.searchsorted(xi_m[:n], xs[order])
+    inside_at = np.empty(k_new, dtype=np.int64)
+    n_inside = 0
+    for j in range(k_new):
+        if inside[order[j]]:
+            inside_at[n_inside] = at[j] + j
+            n_inside += 1
+    insert_batch(mesh, n, xs, Y_ev[new], np.where(inside, 1, 0).astype(np.int64),
+                 np.zeros((k_new, D_m.shape[1])), np.where(inside, t1, 0.0), t1)
+    return k_new, inside_at[:n_inside]

@@ -152,10 +152,8 @@ def refine(stepper) -> int:
             or (not stepper.setup.flat and _stateless(stepper.setup.law))):
         return 0  # an elastic smooth contact places fresh elements in every evaluation
     nodes = stepper.nodes
-    lo, hi = nodes.below(now.alpha), nodes.below(now.beta)
-    inside = nodes.xi[lo:hi]
-    inside = inside[(inside > now.alpha) & (inside < now.beta)]
-    if inside.size >= MIN_INSIDE:
+    # (the elements strictly inside, counted on the sorted mesh: this runs every step)
+    if nodes.below(now.beta) - nodes.at_most(now.alpha) >= MIN_INSIDE:
         return 0
     theta_a = math.atan2(math.sqrt(max((now.beta - now.alpha) * (now.beta + now.alpha), 0.0)),
                          now.alpha)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -144,6 +144,10 @@ class Nodes:
         """Number of elements with ``xi < x``."""
         return int(np.searchsorted(self.xi[:self.n], x))
 
+    def at_most(self, x: float) -> int:
+        """Number of elements with ``xi <= x``."""
+        return int(np.searchsorted(self.xi[:self.n], x, side="right"))
+
 
 @dataclass
 class Instant:
@@ -168,4 +172,11 @@ class Instant:
 
     def copy(self, **changes) -> "Instant":
         changes.setdefault("Hf", self.Hf.copy())
-        return replace(self, **changes)
+        # (dataclasses.replace re-runs __init__: a tenth of a commit, every step)
+        unknown = changes.keys() - self.__dict__.keys()
+        if unknown:
+            raise TypeError(f"Instant has no field {sorted(unknown)}")
+        new = object.__new__(Instant)
+        new.__dict__.update(self.__dict__)
+        new.__dict__.update(changes)
+        return new

@@ -49,6 +49,18 @@ class Evaluation:
     U: np.ndarray  # their displacements at the end of the step
     Hf: np.ndarray  # the arms' filtered lift at the end of the step
 
+    # (``xi`` and ``flags`` of the rows ``Y``, ``U`` are set by :meth:`Step._evaluate`; most
+    # evaluations are trials nobody commits, so the masks are made when asked for)
+    @property
+    def virtual(self) -> np.ndarray:
+        """The rows of elements the step places (new ones)."""
+        return self.flags == 1
+
+    @property
+    def stays(self) -> np.ndarray:
+        """The rows of contact elements that stay in contact."""
+        return self.flags == 2
+
 
 def is_fresh(setup) -> bool:
     """Whether each evaluation places its own elements: an elastic smooth contact has no
@@ -285,6 +297,6 @@ class Step:
         ev = Evaluation(alpha, beta, H_new, Hdot, res[K.R_GAP], res[K.R_EDGE_LOAD],
                         res[K.R_F_CONTACT], res[K.R_F_TOTAL],
                         res[K.R_CENTRE_U], lo, hi, out[1][:m], out[2][:m], Hf)
-        ev.xi, ev.virtual, ev.stays = out[0][:m], out[3][:m] == 1, out[3][:m] == 2
+        ev.xi, ev.flags = out[0][:m], out[3][:m]
         ev.dt = self.dt
         return ev
