@@ -715,3 +715,28 @@ def test_an_instant_copies_with_its_changes_and_its_own_filtered_lift():
     assert now.Hf[0] == 0.25 and now.t == 1.0
     with pytest.raises(TypeError, match="betta"):
         now.copy(betta=1.0)
+
+
+@pytest.mark.parametrize("config", ["sls_finite_punch.yaml", "separation_kv.yaml",
+                                    "prony_external.yaml", "seed_flat_punch.yaml"])
+def test_an_element_replayed_from_the_rows_has_the_state_a_resident_one_has(config):
+    """contact_replay.replay (compiled: kernels.contact.replay_elements) runs new elements
+    from t = 0 through every row's paths: at the onset, elements placed where resident free
+    elements are (released by the receding edge on the face, or loaded by the zone outside
+    the punch) get their modes to rounding (measured 6e-16 to 8e-16 of the largest); one
+    placed where the edge still holds the surface cannot be replayed and is refused."""
+    scene = load_scene(CONFIGS / config, overrides=["model.until=detach"])
+    stepper = contact.run_level(scene, 16)
+    nodes, now = stepper.nodes, stepper.now
+    live = np.arange(nodes.n)
+    current = live[(nodes.status[:nodes.n] == contact_state.FREE)
+                   & (nodes.t_last[:nodes.n] == now.t) & (nodes.xi[:nodes.n] > now.alpha)]
+    assert current.size >= 8
+    replayed = contact_replay.replay(stepper, nodes.xi[current].copy())
+    modes = stepper.setup.law.n_modes
+    resident = nodes.Y[current, :modes]
+    scale = np.max(np.abs(resident))
+    assert scale > 0.0
+    np.testing.assert_allclose(replayed[:, :modes], resident, rtol=0.0, atol=1e-12 * scale)
+    if now.alpha > 0.0:
+        assert contact_replay.replay(stepper, np.array([0.5 * now.alpha])) is None

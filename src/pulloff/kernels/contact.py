@@ -959,23 +959,33 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
 
 
 @njit(cache=True)
-def trial_gap(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
+def _no_state(nm):
+    """What :func:`trial_state` returns for a trial it could not evaluate."""
+    return 0, 0, 0, (np.empty(0), np.empty((0, nm)), np.empty(0), np.empty(0, dtype=np.int64)), \
+        np.empty(R_N)
+
+
+@njit(cache=True)
+def trial_state(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta``, as
     ``Step.evaluate`` gives it (the same :func:`trial_ranges`) for a step that is not fresh
-    (``Step.compiled_secant`` refuses those). ``sc0``: the step's constants with the lift and
-    its rate set; ``lift``: its path; ``edges``: see ``E_*``; ``n_all`` elements in
-    ``mesh``."""
+    (``Step.compiled_secant`` refuses those), with the rest of that evaluation: ``(lo, hi)``,
+    the rows written ``m``, the rows ``out`` and ``res`` of :func:`evaluate_step`. ``sc0``:
+    the step's constants with the lift and its rate set; ``lift``: its path; ``edges``: see
+    ``E_*``; ``n_all`` elements in ``mesh``. nan where the trial reaches archived
+    elements (the Python search brings them back)."""
     paths = np.empty((3, 3))
     sc = sc0.copy()
-    lo, hi = trial_ranges(alpha, beta, mesh[0], n_all, edges, lift, paths, sc)
-    if hi < 0:  # the archived elements are needed: the Python search brings them back
-        return math.nan
-    size = (hi - lo) + int(sc[S_K_ALPHA]) + int(sc[S_K_BETA]) + 1
     nm = stepw[0].size
+    lo, hi = trial_ranges(alpha, beta, mesh[0], n_all, edges, lift, paths, sc)
+    if hi < 0:
+        m, lo, hi, out, res = _no_state(nm)
+        return math.nan, lo, hi, m, out, res
+    size = (hi - lo) + int(sc[S_K_ALPHA]) + int(sc[S_K_BETA]) + 1
     out = (np.empty(size), np.empty((size, nm)), np.empty(size), np.empty(size, dtype=np.int64))
     res = np.empty(R_N)
-    evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha, beta, n_all, prof, out, res)
-    return res[R_GAP] - 1.0
+    m = evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha, beta, n_all, prof, out, res)
+    return res[R_GAP] - 1.0, lo, hi, m, out, res
 
 
 @njit(cache=True)
@@ -1006,11 +1016,13 @@ def flat_edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
 def _edge_residual(x, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     """The residual a phase's secant searches: a flat punch's receding edge at ``x`` with the
     zone end from the edge condition (``alpha`` nan), or the zone end at ``x`` with the edge
-    held at ``alpha``."""
+    held at ``alpha``; with the edges tried and the rest of :func:`trial_state`."""
     if math.isnan(alpha):
-        beta = flat_edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
-        return trial_gap(x, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all)
-    return trial_gap(alpha, x, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+        a, b = x, flat_edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
+    else:
+        a, b = alpha, x
+    f, lo, hi, m, out, res = trial_state(a, b, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+    return f, (a, b, lo, hi, m, out, res)
 
 
 _XTOL = 1e-14
@@ -1023,36 +1035,38 @@ def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw,
                 edges, lift, n_all):
     """``contact_phases._secant`` on :func:`_edge_residual` (``alpha``: see there), step for
     step (the same iterates, brackets and stopping rules): the root, or nan where it gives
-    up."""
+    up; and the evaluation at the last iterate tried (the root, where one is returned), as
+    :func:`_edge_residual` gives it."""
     x0, f0 = x_held, f_held
     x1 = min(max(x_guess, lo), hi)
     if x1 == x0:
-        return math.nan
-    f1 = _edge_residual(x1, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+        m, lo0, hi0, out, res = _no_state(stepw[0].size)
+        return math.nan, (math.nan, math.nan, lo0, hi0, m, out, res)
+    f1, last = _edge_residual(x1, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
     bracketed, b_lo, b_hi = False, 0.0, 0.0
     slope = math.nan
     for _ in range(40):
         if math.isnan(f1):
-            return math.nan
+            return math.nan, last
         if abs(x1 - x0) > 1e-9 * max(abs(x1), 1e-300):
             slope = (f1 - f0) / (x1 - x0) if x1 != x0 else math.nan
         if f1 == 0.0 or abs(f1) <= 1e-14:
-            return x1
+            return x1, last
         if (f1 > 0.0) != (f0 > 0.0):
             bracketed, b_lo, b_hi = True, min(x0, x1), max(x0, x1)
         elif bracketed and not b_lo <= x1 <= b_hi:
-            return math.nan
+            return math.nan, last
         if abs(x1 - x0) <= _XTOL * max(abs(x1), 1e-300) and bracketed:
-            return x1
+            return x1, last
         x2 = x1 - f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else math.nan
         if (abs(f1) <= _SMALL_RESIDUAL
                 and abs(f1) <= abs(slope) * _STALL * max(abs(x1), 1e-300)):
-            return x1
+            return x1, last
         if bracketed and not b_lo < x2 < b_hi:
             x2 = 0.5 * (b_lo + b_hi)
         if not (lo <= x2 <= hi) or abs(x2 - x_held) > reach:
-            return math.nan
-        f2 = _edge_residual(x2, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
+            return math.nan, last
+        f2, last = _edge_residual(x2, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
         if bracketed and not math.isnan(f2):
             if (f2 > 0.0) != (f1 > 0.0):
                 b_lo, b_hi = min(x1, x2), max(x1, x2)
@@ -1061,7 +1075,7 @@ def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw,
                     b_lo if x2 > 0.5 * (b_lo + b_hi) else b_hi)
                 b_lo, b_hi = min(keep, x2), max(keep, x2)
         x0, f0, x1, f1 = x1, f1, x2, f2
-    return math.nan
+    return math.nan, last
 
 
 @njit(cache=True)
@@ -1173,3 +1187,88 @@ def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthe
     insert_batch(mesh, n, xs, Y_ev[new], np.where(inside, 1, 0).astype(np.int64),
                  np.zeros((k_new, D_m.shape[1])), np.where(inside, t1, 0.0), t1)
     return k_new, inside_at[:n_inside]
+
+
+# --- new elements replayed from the rows ----------------------------------------------------------
+@njit(cache=True)
+def _replayed_contact_modes(x, H, Hf, maxwell, V_inv, sc, prof, out):
+    """Modes of a contact element at ``x`` (lift ``H``, arms' filtered lift ``Hf``), as
+    ``contact_replay._contact_modes``: Kelvin-Voigt its displacement, Maxwell its dashpots."""
+    G = _profile(sc, x, prof)
+    if not maxwell:
+        out[0] = H + G
+        return
+    out[:V_inv.shape[0]] = np.dot(V_inv, Hf + G)
+
+
+@njit(cache=True)
+def replay_elements(rows, kink, row_Hf, xs, lam, z, ctil, d, tau_arms, V_inv, maxwell, sc,
+                    prof, Y):
+    """``contact_replay.replay`` compiled: the modes (rows of ``Y``, zeroed) at the last row
+    of elements at ``xs``, each run from the first row through every step of ``rows`` (the
+    stepper's rows: t, H, alpha, beta, ...; ``kink[k]``: row ``k`` is an event's;
+    ``row_Hf[k]``: the arms' filtered lift there). False (``Y`` then meaningless) where one
+    of them joined the contact on the way: its memory of joining is not in the rows."""
+    nm = lam.size
+    n = xs.size
+    Y[:, :] = 0.0
+    free = xs > rows[0, 2]
+    w3 = np.zeros((max(nm, 1), 3))
+    ap, bp, hp = np.empty(3), np.empty(3), np.empty(3)
+    s0 = np.zeros(n)
+    hf_c = np.empty(row_Hf.shape[1])
+    for k in range(1, rows.shape[0]):
+        t0, t1 = rows[k - 1, 0], rows[k, 0]
+        dt = t1 - t0
+        if dt <= 0.0:  # a jump: the contact lets go of what it no longer covers, at once
+            for j in range(n):
+                if not free[j] and xs[j] > rows[k, 2]:
+                    _replayed_contact_modes(xs[j], rows[k - 1, 1], row_Hf[k - 1], maxwell,
+                                            V_inv, sc, prof, Y[j])
+                    free[j] = True
+            continue
+        r = math.nan
+        if k >= 2 and not kink[k - 1] and rows[k - 1, 0] > rows[k - 2, 0]:
+            r = (t0 - rows[k - 2, 0]) / (t1 - t0)
+        for path, column in ((bp, 3), (ap, 2), (hp, 1)):
+            prev = rows[k - 2, column] if not math.isnan(r) else math.nan
+            _quadratic(prev, rows[k - 1, column], rows[k, column], r, path)
+        mus = -lam * dt
+        for m in range(nm):
+            fitted_radau3(mus[m], w3[m])
+        a_end = path_value(ap[0], ap[1], ap[2], 1.0)
+        for j in range(n):
+            if free[j] and xs[j] < a_end:
+                return False  # captured by an advancing edge: not replayable from the rows
+        for j in range(n):
+            s0[j] = 0.0
+        for j in range(n):
+            if free[j] or a_end >= xs[j]:
+                continue  # free already, or still in contact at the end of the step
+            count, r1, _ = path_roots2(ap[0], ap[1], ap[2], xs[j], -1e-12, 1.0 + 1e-12)
+            s_c = min(max(r1, 0.0), 1.0) if count else 1.0
+            h_c = path_value(hp[0], hp[1], hp[2], s_c)
+            if maxwell:
+                _filtered_lift(row_Hf[k - 1], dt / tau_arms, hp, s_c, hf_c)
+            else:
+                hf_c[:] = row_Hf[k - 1]
+            _replayed_contact_modes(xs[j], h_c, hf_c, maxwell, V_inv, sc, prof, Y[j])
+            s0[j] = s_c
+            free[j] = True
+        idx = np.nonzero(free)[0]
+        if idx.size and nm:
+            Yn = np.zeros((idx.size, nm))
+            U = np.zeros(idx.size)
+            Y0 = np.empty((idx.size, nm))
+            for i in range(idx.size):
+                for m in range(nm):
+                    Y0[i, m] = Y[idx[i], m]
+            free_field(xs[idx], Y0, s0[idx], 0, idx.size, bp[0], bp[1], bp[2], mus, z * dt,
+                       ctil, d, nm, w3, Yn, U)
+            for i in range(idx.size):
+                for m in range(nm):
+                    Y[idx[i], m] = Yn[i, m]
+    for j in range(n):
+        if not free[j]:
+            return False
+    return True

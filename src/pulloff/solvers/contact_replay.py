@@ -13,7 +13,6 @@ import numpy as np
 
 from ..kernels import contact as K
 from . import contact_state as st
-from .contact_step import quadratic_path
 
 #: The fewest elements strictly inside the zone before new ones are replayed into it.
 MIN_INSIDE = 8
@@ -57,16 +56,6 @@ def _may_thin(stepper) -> bool:
             or stepper.lift_driven or stepper.setup.until == "detach")
 
 
-def _paths(rows, kinks, k, column):
-    """The quadratic (or, after an event, linear) path of one column over step ``k``."""
-    t0, t1 = rows[k - 1][0], rows[k][0]
-    r = None
-    if k >= 2 and (k - 1) not in kinks and rows[k - 1][0] > rows[k - 2][0]:
-        r = (t0 - rows[k - 2][0]) / (t1 - t0)
-    prev = rows[k - 2][column] if r is not None else None
-    return quadratic_path(prev, rows[k - 1][column], rows[k][column], r)
-
-
 def _stateless(law) -> bool:
     """An elastic solid's elements hold nothing between steps."""
     return law.c == 0.0 and not law.maxwell
@@ -75,73 +64,21 @@ def _stateless(law) -> bool:
 def replay(stepper, xs: np.ndarray):
     """Modes ``Y`` (rows) at the current instant of elements at ``xs``, each run from t = 0
     through every step; None when one of them joined the contact on the way (its memory of
-    joining is not kept in the rows)."""
+    joining is not kept in the rows). Compiled (:func:`pulloff.kernels.contact.
+    replay_elements`): in Python a coarse level of seed_flat_punch, whose thin receding zone
+    is refilled nearly every step, spent 85 % of its time here."""
     s = stepper.setup
     law = s.law
-    nm = law.n_modes
-    rows, kinks, Hfs = stepper.rows, stepper.kinks, stepper.row_Hf
-    n = xs.size
-    Y = np.zeros((n, max(nm, 1)))
-    free = xs > rows[0][2]
-    w3 = np.zeros((max(nm, 1), 3))
-    for k in range(1, len(rows)):
-        t0, t1 = rows[k - 1][0], rows[k][0]
-        dt = t1 - t0
-        if dt <= 0.0:  # a jump: the contact lets go of what it no longer covers, at once
-            for j in np.nonzero(~free & (xs > rows[k][2]))[0]:
-                Y[j] = _contact_modes(stepper, xs[j], rows[k - 1][1], Hfs[k - 1])
-                free[j] = True
-            continue
-        bp = _paths(rows, kinks, k, 3)
-        ap = _paths(rows, kinks, k, 2)
-        hp = _paths(rows, kinks, k, 1)
-        mus = -law.lam * dt
-        for m, mu in enumerate(mus):
-            K.fitted_radau3(mu, w3[m])
-        if np.any(free & (xs < K.path_value(*ap, 1.0))):
-            return None  # captured by an advancing edge: not replayable from the rows
-        s0 = np.zeros(n)
-        for j in np.nonzero(~free)[0]:
-            if K.path_value(*ap, 1.0) >= xs[j]:
-                continue  # still in contact at the end of the step
-            s_c = _crossing(ap, xs[j])
-            h_c = K.path_value(*hp, s_c)
-            Hf_c = _filtered(law, Hfs[k - 1], hp, dt, s_c)
-            Y[j] = _contact_modes(stepper, xs[j], h_c, Hf_c)
-            s0[j] = s_c
-            free[j] = True
-        U = np.zeros(n)
-        idx = np.nonzero(free)[0]
-        if idx.size and nm:
-            Yn = np.zeros((idx.size, nm))
-            K.free_field(xs[idx], Y[idx, :nm].copy(), s0[idx], 0, idx.size, bp[0], bp[1],
-                         bp[2], mus, law.z * dt, law.ctil, law.d, nm, w3, Yn, U[:idx.size])
-            Y[idx, :nm] = Yn
-    return Y if np.all(free) else None
-
-
-def _crossing(p, x):
-    roots = np.empty(2)
-    count = K.path_roots(p[0], p[1], p[2], x, -1e-12, 1.0 + 1e-12, roots)
-    return min(max(roots[0], 0.0), 1.0) if count else 1.0
-
-
-def _filtered(law, Hf0, hp, dt, s):
-    if not law.maxwell:
-        return Hf0
-    out = np.empty(Hf0.size)
-    K._filtered_lift(Hf0, dt / law.tau_arms, np.array(hp, float), s, out)
-    return out
-
-
-def _contact_modes(stepper, x, H, Hf):
-    """Modes of a contact element at ``x`` (lift ``H``): Kelvin-Voigt its displacement,
-    Maxwell its dashpots (a flat punch's bonded elements all share them: no memory term)."""
-    law = stepper.setup.law
-    G = stepper.setup.indenter.g(x)
-    if not law.maxwell:
-        return np.array([H + G])
-    return law.V_inv @ (Hf + G)
+    Y = np.zeros((xs.size, max(law.n_modes, 1)))
+    n_rows = len(stepper.rows)
+    kink = np.zeros(n_rows, dtype=np.bool_)
+    kink[[k for k in stepper.kinks if k < n_rows]] = True
+    row_Hf = np.array(stepper.row_Hf, dtype=float).reshape(n_rows, stepper.row_Hf[0].size)
+    done = K.replay_elements(np.array(stepper.rows, dtype=float), kink, row_Hf,
+                             np.ascontiguousarray(xs, dtype=float), law.lam, law.z, law.ctil,
+                             law.d, law.tau_arms, law.V_inv, law.maxwell,
+                             stepper.step_constants, s.indenter.table, Y)
+    return Y if done else None
 
 
 def refine(stepper) -> int:
@@ -165,8 +102,8 @@ def refine(stepper) -> int:
     Y = replay(stepper, xs)
     if Y is None:
         return 0
-    for x, y in zip(xs, Y):
-        nodes.insert(float(x), y, st.FREE, t_last=now.t)
+    nodes.insert_many(xs, Y, np.full(xs.size, st.FREE), np.zeros((xs.size, nodes.D.shape[1])),
+                      np.zeros(xs.size), now.t)
     return xs.size
 
 

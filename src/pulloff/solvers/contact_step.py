@@ -252,19 +252,38 @@ class Step:
             # back since)
             mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
             sc[K.S_LIVE_END] = nodes.live_end
-            x = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh, self.law,
-                              stepw, table, sc, edges, lift, nodes.n)
-            return None if math.isnan(x) else x
+            x, last = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh,
+                                    self.law, stepw, table, sc, edges, lift, nodes.n)
+            if math.isnan(x):
+                return None
+            # The phase evaluates its root next: the search's last evaluation is that one.
+            a, b, lo_e, hi_e, m, out, res = last
+            self._memo[self._key(a, b, H_new)] = self._evaluation(
+                a, b, H_new, Hdot, Hf if law.maxwell else now.Hf, lo_e, hi_e, m, out, res)
+            return x
         return secant
 
     # --- the free side -------------------------------------------------------------------
     def evaluate(self, alpha, beta, H_new) -> Evaluation:
         """The end of the step for trial edges and lift (:func:`pulloff.kernels.contact.
         evaluate_step` advances every element); a repeated trial is answered from the memo."""
-        key = (alpha, beta, H_new, self.k_alpha, self.k_beta, self.jump, self.s.nodes.n)
+        key = self._key(alpha, beta, H_new)
         ev = self._memo.get(key)
         if ev is None:
             ev = self._memo[key] = self._evaluate(alpha, beta, H_new)
+        return ev
+
+    def _key(self, alpha, beta, H_new):
+        return (alpha, beta, H_new, self.k_alpha, self.k_beta, self.jump, self.s.nodes.n)
+
+    def _evaluation(self, alpha, beta, H_new, Hdot, Hf, lo, hi, m, out, res) -> Evaluation:
+        """An :class:`Evaluation` of what :func:`pulloff.kernels.contact.evaluate_step` wrote
+        (``m`` rows of ``out``, and ``res``)."""
+        ev = Evaluation(alpha, beta, H_new, Hdot, res[K.R_GAP], res[K.R_EDGE_LOAD],
+                        res[K.R_F_CONTACT], res[K.R_F_TOTAL],
+                        res[K.R_CENTRE_U], lo, hi, out[1][:m], out[2][:m], Hf)
+        ev.xi, ev.flags = out[0][:m], out[3][:m]
+        ev.dt = self.dt
         return ev
 
     def _evaluate(self, alpha, beta, H_new) -> Evaluation:
@@ -294,9 +313,4 @@ class Step:
         stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf)
         m = K.evaluate_step(mesh, self.law, stepw, paths, sc, lo, hi, alpha, beta, nodes.n,
                             s.setup.indenter.table, out, res)
-        ev = Evaluation(alpha, beta, H_new, Hdot, res[K.R_GAP], res[K.R_EDGE_LOAD],
-                        res[K.R_F_CONTACT], res[K.R_F_TOTAL],
-                        res[K.R_CENTRE_U], lo, hi, out[1][:m], out[2][:m], Hf)
-        ev.xi, ev.flags = out[0][:m], out[3][:m]
-        ev.dt = self.dt
-        return ev
+        return self._evaluation(alpha, beta, H_new, Hdot, Hf, lo, hi, m, out, res)
