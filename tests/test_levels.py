@@ -44,6 +44,26 @@ def test_three_levels_can_hide_the_error_so_the_ladder_waits_for_four():
     assert ran == [8, 16, 32, 64]
 
 
+def test_a_first_triple_converging_faster_than_the_method_can_is_not_stopped_on():
+    """``h^2`` plus a ``h^8`` term that matters only at the coarsest level: the first three
+    levels measure order 4.5 and an honest estimate 27x the next triple's; with
+    ``first_order_max`` the ladder takes a fourth level and stops on the last three
+    (order 2.1); without, it stops at three."""
+    def out(n):
+        return ladder({2: 1e-2, 8: 1e4}, 1.0 / n, 1)[0]
+
+    for order_max, expected in ((math.inf, [8, 16, 32]), (3.0, [8, 16, 32, 64])):
+        ran = []
+        result = levels.refine(lambda n: ran.append(n) or n, out, 2e-4, 8, ORDER,
+                               can_refine=lambda r, n: n <= 1024, extrapolated="measured",
+                               first_order_max=order_max)
+        assert ran == expected
+        assert abs(result.extrapolated[0] - 1.0) <= result.estimate
+    first = levels.extrapolate_measured([out(n) for n in (8, 16, 32)], ORDER)[1]
+    assert levels.richardson([out(n) for n in (8, 16, 32)], ORDER)[1] > 4.0
+    assert result.estimate < first / 10.0 and 1.5 < result.order < 2.5
+
+
 def test_extrapolation_removes_the_second_order_term_exactly():
     values = ladder({2: 3.0}, 1e-2, 4)
     e, estimate = levels.extrapolate(values, ORDER)

@@ -226,7 +226,8 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
            n_first: int, order: Order, can_refine: Callable[[object, int], bool],
            interrupted: Callable[[object], bool] = lambda r: False,
            extrapolated: str | None = None,
-           floor: Callable[[object], np.ndarray] | None = None) -> Ladder:
+           floor: Callable[[object], np.ndarray] | None = None,
+           first_order_max: float = math.inf) -> Ladder:
     """Run ``n_first, 2 n_first, ...`` until the estimate is below ``rtol / 2`` (from three
     levels on, four with ``extrapolated="method"``) or ``can_refine(finest, next_n)`` says no. The estimate is that of the finest level
     (:func:`richardson`), or with ``extrapolated`` (``"method"``: :func:`extrapolate`,
@@ -237,7 +238,11 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
     difference (the second-order Richardson factor, without a measured order). A level that
     reports ``interrupted`` ends the ladder at once with a nan estimate. ``floor(finest)``
     (optional) gives each output the size below which its error is judged absolutely
-    (:func:`_scale`).
+    (:func:`_scale`). The first three levels are not stopped on where the order they measure
+    exceeds ``first_order_max``: a first level too coarse for the asymptotic range (its
+    error far larger than the order predicts) leaves an extrapolation whose estimate is
+    honest but far too cautious, and the next level is cheaper than the work it would ask
+    of a run that trusts it.
     """
     levels, outs = [], []
     n = n_first
@@ -253,7 +258,9 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
             estimate, measured = richardson(last[-3:], order, lowest)
             if extrapolated:
                 values, estimate = _EXTRAPOLATIONS[extrapolated](last, order, lowest)
-            if estimate <= 0.5 * rtol and len(levels) >= _MIN_LEVELS[extrapolated]:
+            regular = len(levels) > 3 or not measured > first_order_max
+            if (estimate <= 0.5 * rtol and len(levels) >= _MIN_LEVELS[extrapolated]
+                    and regular):
                 return Ladder(levels, estimate, measured, values)
         if not can_refine(levels[-1], 2 * n):
             if len(levels) == 2:
