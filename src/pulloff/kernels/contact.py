@@ -1131,6 +1131,10 @@ def insert_batch(mesh, n, x, Y, status, D, tj, t_last):
     merge_sorted(D_m, n, at, _rows(D, order, D_m.shape[1]))
     merge_sorted(tj_m, n, at, tj[order])
     merge_sorted(t_last_m, n, at, np.full(x.size, t_last))
+    where = np.empty(x.size, dtype=np.int64)
+    for j in range(x.size):
+        where[order[j]] = at[j] + j
+    return where
 
 
 @njit(cache=True)
@@ -1171,21 +1175,29 @@ def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthe
         i += 1
     if k_new == 0:
         return 0, none
-    new = np.nonzero(flags == 1)[0]
-    xs = x_ev[new]
-    inside = (xs > 0.0) & (xs <= alpha)
-    furthest[0] = np.max(xs)
-    # Where insert_batch puts each (its stable order, before old rows at equal x).
-    order = np.argsort(xs, kind="mergesort")
-    at = np.searchsorted(xi_m[:n], xs[order])
+    xs = np.empty(k_new)
+    Ys = np.empty((k_new, Y_ev.shape[1]))
+    status_new = np.zeros(k_new, dtype=np.int64)
+    tj_new = np.zeros(k_new)
+    j_new = 0
+    furthest[0] = -np.inf
+    for j in range(m):
+        if flags[j] != 1:
+            continue
+        xs[j_new] = x_ev[j]
+        Ys[j_new] = Y_ev[j]
+        if 0.0 < x_ev[j] <= alpha:
+            status_new[j_new], tj_new[j_new] = 1, t1
+        furthest[0] = max(furthest[0], x_ev[j])
+        j_new += 1
+    where = insert_batch(mesh, n, xs, Ys, status_new, np.zeros((k_new, D_m.shape[1])), tj_new,
+                         t1)
     inside_at = np.empty(k_new, dtype=np.int64)
     n_inside = 0
     for j in range(k_new):
-        if inside[order[j]]:
-            inside_at[n_inside] = at[j] + j
+        if status_new[j] == 1:
+            inside_at[n_inside] = where[j]
             n_inside += 1
-    insert_batch(mesh, n, xs, Y_ev[new], np.where(inside, 1, 0).astype(np.int64),
-                 np.zeros((k_new, D_m.shape[1])), np.where(inside, t1, 0.0), t1)
     return k_new, inside_at[:n_inside]
 
 
