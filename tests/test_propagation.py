@@ -740,3 +740,27 @@ def test_an_element_replayed_from_the_rows_has_the_state_a_resident_one_has(conf
     np.testing.assert_allclose(replayed[:, :modes], resident, rtol=0.0, atol=1e-12 * scale)
     if now.alpha > 0.0:
         assert contact_replay.replay(stepper, np.array([0.5 * now.alpha])) is None
+
+
+def test_a_zone_alone_whose_first_fold_search_misses_retries_instead_of_bisecting(
+        monkeypatch):
+    """sls_finite_punch.yaml at 1.93e-2 m/s, n = 16: the zone alone's first fold search,
+    beside the bracket the bisection left, finds T above the lost step over part of its
+    window (states the lost step missed). It retries with twice the step, as the search from
+    the predicted window does, and lands on the fold: no bisection of the branch's end (it
+    took 860 of the level's 1800 evaluations), and the separation time within 2e-8 of the
+    level n = 256's (3.566185679e-4 s)."""
+    scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
+                       overrides=["model.until=separation", "loading.v=1.93e-2"])
+    bisected = []
+    longest = contact_stepper.Stepper._longest_step
+
+    def counted(stepper, dt, what):
+        bisected.append((stepper.now.phase, what))
+        return longest(stepper, dt, what)
+
+    monkeypatch.setattr(contact_stepper.Stepper, "_longest_step", counted)
+    stepper = contact.run_level(scene, 16)
+    assert [e for _, e in stepper.events][-2:] == ["jump_out", "separated"]
+    assert (contact_state.ZONE, "zone") not in bisected, bisected
+    assert abs(stepper.summary["t_separation"] / 3.566185679e-4 - 1.0) < 2e-8
