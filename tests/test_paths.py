@@ -270,6 +270,32 @@ def test_a_solid_with_memory_gets_its_two_elastic_limits_beside_the_run():
     assert math.isnan(forms["maugis_F_pulloff_load"])  # the elastic closed forms are not
 
 
+def test_the_closed_forms_beside_a_path_are_kept_per_process_and_never_stale():
+    """analytic.path_predictions caches by what its answer depends on: the same scene at
+    another speed gets the same values (a copy: changing it does not change the cache), and
+    another modulus or stiffer machine gets its own."""
+    from pulloff.model import analytic
+
+    scene = path_scene(13.0)
+    first = analytic.path_predictions(scene)
+    data = scene.model_dump(mode="json", exclude_none=True)
+    data["loading"]["segments"][1]["speed"] = 2e-6
+    faster = parse_scene(data)
+    assert faster.loading.segments[1].speed == 2e-6
+    again = analytic.path_predictions(faster)
+    assert again == first and again is not first
+    again["jkr_F_pulloff_load"] = 0.0
+    assert analytic.path_predictions(scene)["jkr_F_pulloff_load"] == first["jkr_F_pulloff_load"]
+    stiffer = parse_scene({**scene.model_dump(mode="json", exclude_none=True),
+                           "material": {"kind": "elastic", "G": 2.0 * G}})
+    other = analytic.path_predictions(stiffer)
+    profile = ec.mdr_profile_power_law(*stiffer.geometry.power_law())
+    expected = ec.mdr_dugdale_pulloff(profile, 2.0 * G, sigma_c=stiffer.adhesion.sigma_c,
+                                      delta=stiffer.adhesion.delta, control="load").F
+    assert other["mdr_dugdale_F_pulloff_load"] == pytest.approx(expected, rel=1e-12)
+    assert other["mdr_dugdale_F_pulloff_load"] != first["mdr_dugdale_F_pulloff_load"]
+
+
 def test_near_elastic_sls_sphere_is_the_elastic_sphere():
     """An arm of 0.1 % of the modulus (the old stick rule held this contact 10x too long):
     within 0.1 % of the elastic pull-off and jump out (measured 6.7e-4, 6e-4)."""
