@@ -960,9 +960,10 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
 
 @njit(cache=True)
 def _no_state(nm):
-    """What :func:`trial_state` returns for a trial it could not evaluate."""
-    return 0, 0, 0, (np.empty(0), np.empty((0, nm)), np.empty(0), np.empty(0, dtype=np.int64)), \
-        np.empty(R_N)
+    """``(lo, hi, m, out, res)`` of a trial that could not be evaluated (see
+    :func:`trial_state`): empty."""
+    out = (np.empty(0), np.empty((0, nm)), np.empty(0), np.empty(0, dtype=np.int64))
+    return 0, 0, 0, out, np.empty(R_N)
 
 
 @njit(cache=True)
@@ -979,7 +980,7 @@ def trial_state(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     nm = stepw[0].size
     lo, hi = trial_ranges(alpha, beta, mesh[0], n_all, edges, lift, paths, sc)
     if hi < 0:
-        m, lo, hi, out, res = _no_state(nm)
+        lo, hi, m, out, res = _no_state(nm)
         return math.nan, lo, hi, m, out, res
     size = (hi - lo) + int(sc[S_K_ALPHA]) + int(sc[S_K_BETA]) + 1
     out = (np.empty(size), np.empty((size, nm)), np.empty(size), np.empty(size, dtype=np.int64))
@@ -1040,7 +1041,7 @@ def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw,
     x0, f0 = x_held, f_held
     x1 = min(max(x_guess, lo), hi)
     if x1 == x0:
-        m, lo0, hi0, out, res = _no_state(stepw[0].size)
+        lo0, hi0, m, out, res = _no_state(stepw[0].size)
         return math.nan, (math.nan, math.nan, lo0, hi0, m, out, res)
     f1, last = _edge_residual(x1, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
     bracketed, b_lo, b_hi = False, 0.0, 0.0
