@@ -968,20 +968,23 @@ def _no_state(nm):
 
 @njit(cache=True)
 def trial_state(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
-    """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta``, as
-    ``Step.evaluate`` gives it (the same :func:`trial_ranges`) for a step that is not fresh
-    (``Step.compiled_secant`` refuses those), with the rest of that evaluation: ``(lo, hi)``,
-    the rows written ``m``, the rows ``out`` and ``res`` of :func:`evaluate_step`. ``sc0``:
-    the step's constants with the lift and its rate set; ``lift``: its path; ``edges``: see
-    ``E_*``; ``n_all`` elements in ``mesh``. nan where the trial reaches archived
-    elements (the Python search brings them back)."""
+    """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta`` (what
+    ``Step.evaluate`` gives), with the rest of that evaluation: ``(lo, hi)``, the rows
+    written ``m``, the rows ``out`` and ``res`` of :func:`evaluate_step`. ``sc0``: the step's
+    constants with the lift and its rate set; ``lift``: its path; ``edges``: see ``E_*``;
+    ``n_all`` elements in ``mesh``.
+    A step that places its own elements (``sc0[S_FRESH]``) advances none of the mesh. nan,
+    with ``hi`` -1 and nothing evaluated, where the trial reaches archived elements: they
+    must come back first."""
     paths = np.empty((3, 3))
     sc = sc0.copy()
     nm = stepw[0].size
     lo, hi = trial_ranges(alpha, beta, mesh[0], n_all, edges, lift, paths, sc)
     if hi < 0:
-        lo, hi, m, out, res = _no_state(nm)
-        return math.nan, lo, hi, m, out, res
+        lo, _, m, out, res = _no_state(nm)
+        return math.nan, lo, -1, m, out, res
+    if sc[S_FRESH] > 0.0:
+        lo = hi = 0
     size = (hi - lo) + int(sc[S_K_ALPHA]) + int(sc[S_K_BETA]) + 1
     out = (np.empty(size), np.empty((size, nm)), np.empty(size), np.empty(size, dtype=np.int64))
     res = np.empty(R_N)

@@ -296,21 +296,15 @@ class Step:
             Hf = now.Hf
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
-        paths = np.empty((3, 3))
-        lo, hi = K.trial_ranges(alpha, beta, nodes.xi, nodes.n, self.edges, lift, paths, sc)
-        if hi < 0:  # the trial reaches the archived elements: every element is live again
+        stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf)
+        while True:
+            mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            _, lo, hi, m, out, res = K.trial_state(alpha, beta, mesh, self.law, stepw,
+                                                   s.setup.indenter.table, sc, self.edges,
+                                                   lift, nodes.n)
+            if hi >= 0:
+                break
+            # The trial reaches the archived elements: every element is live again.
             nodes.restore()
             self._constants[K.S_LIVE_END] = sc[K.S_LIVE_END] = nodes.live_end
-            lo, hi = K.trial_ranges(alpha, beta, nodes.xi, nodes.n, self.edges, lift, paths, sc)
-        if self.fresh:
-            lo = hi = 0
-        size = (hi - lo) + int(sc[K.S_K_ALPHA]) + int(sc[K.S_K_BETA]) + 1
-        nm = self.mus.size
-        out = (np.empty(size), np.empty((size, nm)), np.empty(size),
-               np.empty(size, dtype=np.int64))
-        res = np.empty(K.R_N)
-        mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
-        stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf)
-        m = K.evaluate_step(mesh, self.law, stepw, paths, sc, lo, hi, alpha, beta, nodes.n,
-                            s.setup.indenter.table, out, res)
         return self._evaluation(alpha, beta, H_new, Hdot, Hf, lo, hi, m, out, res)
