@@ -88,6 +88,16 @@ def test_yaml_special_values():
     assert yaml.safe_load("x: 1e-8")["x"] == "1e-8"  # the stock loader is left alone
 
 
+@pytest.mark.parametrize("name", ["08", "1e5", "+12", "0x1F", "yes", "1:30", "null", "~"])
+def test_a_name_that_looks_like_a_number_reads_back_as_written(name):
+    """scene_to_yaml quotes a string a YAML 1.1 or 1.2 reader would take for something else
+    ('08' is a string to 1.1 but the int 8 to 1.2: hypothesis found it)."""
+    scene = parse_scene({**yaml.load(SEED, Loader=SceneLoader), "name": name})
+    again = parse_scene(yaml.load(scene_to_yaml(scene), Loader=SceneLoader))
+    assert again.name == name
+    assert yaml.safe_load(scene_to_yaml(scene))["name"] == name
+
+
 def test_load_errors(tmp_path):
     with pytest.raises(SceneError, match="cannot read"):
         load_scene(tmp_path / "absent.yaml")

@@ -77,7 +77,8 @@ class _SceneDumper(yaml.SafeDumper):
     ('1e5', 'no', '1:30'), so a written scene reads back the same anywhere."""
 
 
-_SceneDumper.add_implicit_resolver(_TAGS["float"], _CORE_12["float"], list(_FIRST["float"]))
+for _name in ("float", "int"):  # 1.2's ints too: '08' is a string to 1.1 but 8 to 1.2
+    _SceneDumper.add_implicit_resolver(_TAGS[_name], _CORE_12[_name], list(_FIRST[_name]))
 
 
 def read_yaml(text: str, where: str = "scene"):
