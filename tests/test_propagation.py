@@ -764,3 +764,52 @@ def test_a_zone_alone_whose_first_fold_search_misses_retries_instead_of_bisectin
     assert [e for _, e in stepper.events][-2:] == ["jump_out", "separated"]
     assert (contact_state.ZONE, "zone") not in bisected, bisected
     assert abs(stepper.summary["t_separation"] / 3.566185679e-4 - 1.0) < 2e-8
+
+
+@pytest.mark.parametrize("v", [1e-5, 1.93e-2])
+def test_a_fold_search_started_from_its_last_root_lands_where_the_bracketed_one_does(
+        monkeypatch, v):
+    """The fold search maximises T(x), the step after which the zone end reaches x. Each T
+    now starts a secant from the root at the nearest x already searched, instead of
+    bracketing the whole step (about 10 evaluations per x, 250 per fold, a fifth of the
+    standard linear solid's rate sweep): the separation time is the bracketed search's to
+    rounding (the rows before the fold do not change at all), with less than half of its
+    evaluations."""
+    scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
+                       overrides=["model.until=separation", f"loading.v={v}"])
+    counted = [0]
+    residual = contact_fold._residual
+
+    def counting(*args):
+        counted[0] += 1
+        return residual(*args)
+
+    monkeypatch.setattr(contact_fold, "_residual", counting)
+    warm = contact.run_level(scene, 16)
+    warm_count = counted[0]
+    counted[0] = 0
+    monkeypatch.setattr(contact_fold, "_secant_from", lambda *args: None)
+    bracketed = contact.run_level(scene, 16)
+    assert [e for _, e in warm.events] == [e for _, e in bracketed.events]
+    assert warm.events[-1][1] == "separated"
+    assert len(warm.rows) == len(bracketed.rows)
+    np.testing.assert_array_equal(np.array(warm.rows[:-2]), np.array(bracketed.rows[:-2]))
+    t_warm, t_bracketed = warm.summary["t_separation"], bracketed.summary["t_separation"]
+    assert abs(t_warm / t_bracketed - 1.0) < 1e-14
+    assert 0 < warm_count < 0.5 * counted[0], (warm_count, counted[0])
+
+
+def test_the_secant_from_the_nearest_root_finds_a_smooth_root_and_gives_way_elsewhere():
+    """:func:`contact_fold._secant_from` on a smooth residual: the root to its tolerance from
+    the nearest earlier root; None with no earlier root, or where an iterate leaves the
+    allowed steps (the caller then brackets)."""
+    def residual(d, x):
+        return math.expm1(3.0 * d) - x  # root log1p(x)/3
+
+    x = 0.2
+    root = math.log1p(x) / 3.0
+    found = [(0.5, 0.2), (0.21, 0.9 * root)]
+    d = contact_fold._secant_from(found, x, residual, 1e-12, 1.0)
+    assert abs(d - root) <= 1e-14 * root
+    assert contact_fold._secant_from([], x, residual, 1e-12, 1.0) is None
+    assert contact_fold._secant_from(found, x, residual, 1e-12, 0.5 * root) is None

@@ -30,6 +30,10 @@ _AT_ONCE = 1e-9
 #: The predictor's window reaches this many predicted moves of ``x`` past the last state.
 _AHEAD = 4.0
 NOW = "now"
+#: Secant iterations before a warm-started search for ``T(x)`` gives way to a bracket.
+_SECANT_TRIES = 8
+#: The rounding of a residual (a gap relative to ``delta`` less 1, or a force balance).
+_RESIDUAL_ROUNDING = 8e-15
 #: What :func:`_maximise` returns where ``T`` exceeds the lost step over part of its window.
 _BEYOND = "beyond"
 
@@ -107,16 +111,24 @@ def _maximise(stepper, window, tiny, d_lost, d_ok):
     """The fold as the maximum of ``T`` over ``window``: ``(step, evaluation)``, or None where
     the maximum lies on the window's edge or below ``d_ok`` (not the fold looked for)."""
     lo, hi = window
+    found = []  # (x, T(x)) of every root so far: where the next search starts
+
+    def residual(d, x):
+        return _residual(stepper, x, d)[0]
 
     def steps_to(x):
         """T(x): the step after which ``x`` holds (0 where no step up to ``d_lost`` reaches
         it: beyond the branch)."""
-        r_lo = _residual(stepper, x, tiny)[0]
-        r_hi = _residual(stepper, x, d_lost)[0]
-        if not (math.isfinite(r_lo) and math.isfinite(r_hi)) or (r_lo > 0.0) == (r_hi > 0.0):
-            return 0.0
-        return brentq(lambda d: _residual(stepper, x, d)[0], tiny, d_lost,
-                      xtol=1e-15 * d_lost, rtol=1e-15)
+        d = _secant_from(found, x, residual, tiny, d_lost)
+        if d is None:
+            r_lo = residual(tiny, x)
+            r_hi = residual(d_lost, x)
+            if (not (math.isfinite(r_lo) and math.isfinite(r_hi))
+                    or (r_lo > 0.0) == (r_hi > 0.0)):
+                return 0.0
+            d = brentq(residual, tiny, d_lost, args=(x,), xtol=1e-15 * d_lost, rtol=1e-15)
+        found.append((x, d))
+        return d
 
     best = minimize_scalar(lambda x: -steps_to(x), bounds=(lo, hi), method="bounded",
                            options={"xatol": 1e-12 * max(abs(hi), 1.0)})
@@ -137,6 +149,37 @@ def _maximise(stepper, window, tiny, d_lost, d_ok):
     if ev is None or stepper.crossed(ev) is not None:
         return None  # an event comes first: the caller lands on it
     return step, ev
+
+
+def _secant_from(found, x, residual, tiny, d_lost):
+    """``T(x)`` by the secant method from the roots found at the nearest ``x`` (``T`` is
+    smooth in ``x``, so they start it within a hair of the root), or None where there are
+    none, an iterate leaves ``(tiny, d_lost)`` or it does not settle within
+    :data:`_SECANT_TRIES` (the caller then brackets). A bracketed search from the whole
+    ``(tiny, d_lost)`` took 10 evaluations per ``x``, 250 per fold: a fifth of the standard
+    linear solid's rate sweep."""
+    if not found:
+        return None
+    x0, d0 = min(found, key=lambda p: abs(p[0] - x))
+    d1 = d0 * (1.0 + 1e-7) if d0 > 0.0 else 0.0
+    if not tiny < d1 < d_lost:
+        return None
+    f0, f1 = residual(d0, x), residual(d1, x)
+    for _ in range(_SECANT_TRIES):
+        if f1 == 0.0:
+            return d1
+        if not (math.isfinite(f0) and math.isfinite(f1)) or f1 == f0:
+            return None
+        slope = (f1 - f0) / (d1 - d0)
+        d2 = d1 - f1 / slope
+        if not tiny < d2 < d_lost:
+            return None
+        # Converged to brentq's tolerance, or to the band where the residual's rounding
+        # (~1e-15, gap - 1 with a gap near 1) decides its sign: no bracket resolves it finer.
+        if abs(d2 - d1) <= 1e-15 * d_lost + 1e-14 * abs(d2) + _RESIDUAL_ROUNDING / abs(slope):
+            return d2
+        d0, f0, d1, f1 = d1, f1, d2, residual(d2, x)
+    return None
 
 
 def _near_fold(stepper, dt):
