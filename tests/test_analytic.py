@@ -581,3 +581,25 @@ def test_property_elastic_gap_condition_any_scale(log_chi, log_a):
     g = S * math.atan(S) - S * S / (1 + math.sqrt(1 + S * S))
     assert rel(g, c) < 1e-13
     assert rel(r["h"], sigma_c * a * S / (2 * G)) < 1e-15
+
+
+_ANY_FLOAT = st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                       st.sampled_from([0.0, -0.0, 1e-320, 1e-300, 1e300]))
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.tuples(*([_ANY_FLOAT] * 6)))
+def test_property_the_groups_of_python_floats_are_their_array_form_bit_for_bit(values):
+    """``alpha``, ``chi`` and ``V`` of Python floats (a scene's numbers) take a scalar path;
+    it returns the array form's value to the bit, zeros, infinities and nans included, and a
+    Python float."""
+    G, eta, sigma_c, delta, a, v = values
+    pairs = ((A.alpha, (G, eta, sigma_c, delta, a, v)), (A.chi, (G, sigma_c, delta, a)),
+             (A.V, (eta, v, sigma_c, a)))
+    with np.errstate(all="ignore"):
+        for form, args in pairs:
+            scalar = form(*args)
+            array = form(np.asarray(args[0]), *args[1:])
+            assert type(scalar) is float
+            assert (scalar == array and math.copysign(1.0, scalar) == math.copysign(1.0, array)
+                    or math.isnan(scalar) and math.isnan(array)), (form.__name__, args)
