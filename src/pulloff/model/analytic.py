@@ -110,9 +110,11 @@ _ALPHA_FIXED_POINT_MIN = 100.0  # t* > 14: e^{-t*} < 1e-6, the large-alpha itera
 
 
 def _horner(coeffs, x):
-    acc = np.zeros_like(x) + coeffs[-1]
+    # In place: the history's cohesive force runs 30 terms over every row of a run.
+    acc = np.full(np.shape(x), coeffs[-1], dtype=float)
     for c in coeffs[-2::-1]:
-        acc = acc * x + c
+        np.multiply(acc, x, out=acc)
+        np.add(acc, c, out=acc)
     return acc
 
 

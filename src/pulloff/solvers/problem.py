@@ -99,13 +99,16 @@ class Problem:
 def si_history(problem: "Problem", t, gap) -> dict:
     """History columns in SI (:mod:`pulloff.model.outputs`) of the flat punch with its bond
     radius fixed, from dimensionless times and gaps."""
+    b = problem.zone_end(t)
+    F_contact = problem.contact_force(t)
     return {
         "t": t * problem.time_scale,
         "h": problem.lift(t),
         "a": np.full(np.shape(t), problem.a),
-        "b": problem.zone_end(t),
+        "b": b,
         "gap": gap * problem.delta,
-        "F_contact": problem.contact_force(t),
-        "F_total": problem.total_force(t),
+        "F_contact": F_contact,
+        # (total_force's own sum, without computing b and F_contact again)
+        "F_total": F_contact + analytic.cohesive_force(problem.sigma_c, problem.a, b),
         "segment": np.zeros(np.shape(t)),  # a pull is one segment
     }
