@@ -16,6 +16,7 @@ step from ``rtol``, checks it by step doubling (:mod:`.levels`), and converts ba
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -166,7 +167,8 @@ class _History:
         self.stream = stream
         self.stream_every = max(1, int(stream_every))
         self.steps, self.gaps = [], []
-        self.tail = np.zeros((0, 2))  # the last four raw rows (time, gap): event location
+        # The last four raw rows (times, gaps): event location.
+        self.tail = (np.zeros(0), np.zeros(0))
 
     def add(self, steps: np.ndarray, t: np.ndarray, gap: np.ndarray) -> None:
         if self.every == 1:
@@ -182,9 +184,10 @@ class _History:
             if np.any(send):
                 self.stream(si_history(self.problem, t[send], gap[send]))
         if t.size >= 4:
-            self.tail = np.column_stack([t[-4:], gap[-4:]])
+            self.tail = (t[-4:], gap[-4:])
         else:
-            self.tail = np.concatenate([self.tail, np.column_stack([t, gap])])[-4:]
+            self.tail = (np.concatenate([self.tail[0], t])[-4:],
+                         np.concatenate([self.tail[1], gap])[-4:])
 
     def arrays(self, dt, last_step):
         steps = np.concatenate(self.steps) if self.steps else np.zeros(0, dtype=np.int64)
@@ -192,7 +195,7 @@ class _History:
         if steps.size == 0 or steps[-1] != last_step:
             # The run's last row always belongs to the history, recorded or not.
             steps = np.append(steps, last_step)
-            gaps = np.append(gaps, self.tail[-1, 1])
+            gaps = np.append(gaps, self.tail[1][-1])
         return steps, steps * dt, gaps
 
 
@@ -222,7 +225,7 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     n_born = 1
     weights = step_weights(k, c, dt, n_stop + 2)
     history = _History(problem, record_every, stream, stream_every)
-    gap0 = float(frozen_gap(problem, 0.0))  # the frozen and exact states agree at t = 0
+    gap0 = _start_gap(problem)
     history.add(np.zeros(1, dtype=np.int64), np.zeros(1), np.array([gap0]))
     if gap0 >= 1.0:
         return FoundationRun(dt, np.zeros(1), np.array([gap0]), 0.0, sig_pre.size + n_born, 0,
@@ -265,13 +268,20 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
         # Compiled code does not see signals; Python raises on return, before ``step`` is
         # updated, so the arrays and the history hold a consistent state up to ``step``.
         interrupted = True
-    tail = history.tail
-    t_detach = _crossing_time(tail[:, 0], tail[:, 1], tail.shape[0] - 1) if crossed else math.nan
+    t_tail, gap_tail = history.tail
+    t_detach = _crossing_time(t_tail, gap_tail, t_tail.size - 1) if crossed else math.nan
     t_end = t_detach if crossed else step * dt
     snapshots = _snapshots(problem, wanted, captured, dt, t_end)
     steps, t, gap = history.arrays(dt, step)
     return FoundationRun(dt, t, gap, t_detach, sig_pre.size + n_born, step, snapshots,
                          interrupted, steps=steps, n_thinned=n_thinned)
+
+
+@functools.lru_cache(maxsize=256)
+def _start_gap(problem: Problem) -> float:
+    """The gap at ``t = 0``, where the frozen and exact states agree (once per problem: every
+    level of a ladder starts there)."""
+    return float(frozen_gap(problem, 0.0))
 
 
 def _entered_arrays(capacity: int, max_elements):
@@ -287,12 +297,14 @@ def _stops(snapshot_times, dt: float, n_stop: int):
     for progress and Ctrl-C (a signal is seen when the kernel returns; the rows of that call
     are lost), at least _MIN_CHUNK steps apart so small runs pay no overhead. Returns
     ``(wanted, capture_steps, stops)``."""
+    chunk = max(_MIN_CHUNK, n_stop // 50)
+    if not snapshot_times and 0 < n_stop <= chunk:
+        return {}, set(), [n_stop]  # a ladder's level: one call of the kernel
     wanted = {}
     for ts in snapshot_times:
         n0 = min(n_stop, max(0, int(math.floor(ts / dt))))
         wanted[ts] = (n0, min(n_stop, n0 + 1))
     capture_steps = {n for pair in wanted.values() for n in pair}
-    chunk = max(_MIN_CHUNK, n_stop // 50)
     stops = sorted((set(range(chunk, n_stop, chunk)) | capture_steps | {n_stop}) - {0})
     return wanted, capture_steps, stops
 

@@ -8,6 +8,7 @@ Lengths along the foundation in units of the punch radius ``a``, displacements, 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,10 +80,15 @@ class Problem:
     # --- SI views of a dimensionless time -------------------------------------------------
     def lift(self, t):
         """Punch lift ``h`` [m] at dimensionless time ``t``."""
+        if type(t) is float:  # (the same operations without numpy: every level's outputs)
+            return self.h0 + self.v * self.time_scale * t
         return self.h0 + self.v * self.time_scale * np.asarray(t, dtype=float)
 
     def zone_end(self, t):
         """Cohesive-zone end ``b`` [m] at dimensionless time ``t``."""
+        if type(t) is float:
+            s = self.s_of(t)
+            return self.a * math.sqrt(1.0 + s * s)
         s = self.s_of(np.asarray(t, dtype=float))
         return self.a * np.sqrt(1.0 + s * s)
 
