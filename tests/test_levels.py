@@ -201,7 +201,9 @@ def _richardson_as_arrays(values, order, floor):
     worst = int(np.argmax(d_last))
     if d_last[worst] == 0.0:
         return 0.0, math.nan
-    with np.errstate(over="ignore"):  # (a tiny last change: inf, as Python floats give)
+    # (a tiny last change: inf; both changes inf over a subnormal floor: nan; as Python
+    # floats give, silently)
+    with np.errstate(over="ignore", invalid="ignore"):
         ratio = d_prev[worst] / d_last[worst]
     measured = math.log2(ratio) if d_prev[worst] > 0 else order.high
     if measured < levels.DIVERGING_ORDER:
