@@ -7,6 +7,7 @@ is ``nan`` (or empty text) in its result, never missing.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 #: Which scenes have a quantity (the ``where`` of :class:`Quantity`), as a user reads it.
@@ -146,7 +147,9 @@ OUTPUTS = (
 BY_NAME = {q.name: q for q in OUTPUTS}
 
 
+@functools.lru_cache(maxsize=None)
 def of_group(group: str) -> tuple[Quantity, ...]:
+    # (once per group: every result is built from these, ~70 quantities a call)
     return tuple(q for q in OUTPUTS if q.group == group)
 
 

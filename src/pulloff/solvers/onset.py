@@ -75,8 +75,8 @@ def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
     Newton from the linear guess, kept inside the step.
     """
     first = max(0, n - 3)
-    t_pts = [float(x) for x in t[first:n + 1]]
-    coef = [float(x) for x in gap[first:n + 1]]
+    t_pts = t[first:n + 1].tolist()
+    coef = gap[first:n + 1].tolist()
     t1, t2, g1, g2 = t_pts[-2], t_pts[-1], coef[-2], coef[-1]
     t_lin = t1 + (1.0 - g1) * (t2 - t1) / (g2 - g1)
     m = len(t_pts)
@@ -449,8 +449,8 @@ def _n_steps_for(rtol: float) -> int:
     return int(min(_MAX_STEPS, max(_MIN_STEPS, math.ceil((_STEP_CONSTANT / rtol) ** (1 / 3)))))
 
 
-def _detach_outputs(problem: Problem, t: float):
-    return np.array([t, problem.contact_force(t), problem.total_force(t)], dtype=float)
+def _detach_outputs(problem: Problem, t: float, *more):
+    return np.array([t, problem.contact_force(t), problem.total_force(t), *more], dtype=float)
 
 
 def _outputs(problem: Problem, run: FoundationRun) -> np.ndarray:
@@ -458,7 +458,7 @@ def _outputs(problem: Problem, run: FoundationRun) -> np.ndarray:
     that does not detach (all levels end at the same time then)."""
     if math.isnan(run.t_detach):
         return np.array([math.nan, math.nan, math.nan, run.gap[-1]])
-    return np.append(_detach_outputs(problem, run.t_detach), math.nan)
+    return _detach_outputs(problem, run.t_detach, math.nan)
 
 
 #: Steps of the fixed-step mode's default element arrays (``numerics.max_elements``).
