@@ -1208,8 +1208,9 @@ def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthe
 # --- new elements replayed from the rows ----------------------------------------------------------
 @njit(cache=True)
 def _replayed_contact_modes(x, H, Hf, maxwell, V_inv, sc, prof, out):
-    """Modes of a contact element at ``x`` (lift ``H``, arms' filtered lift ``Hf``), as
-    ``contact_replay._contact_modes``: Kelvin-Voigt its displacement, Maxwell its dashpots."""
+    """Modes of a contact element at ``x`` (lift ``H``, arms' filtered lift ``Hf``):
+    Kelvin-Voigt its displacement, Maxwell its dashpots (a flat punch's bonded elements all
+    share them: no memory term)."""
     G = _profile(sc, x, prof)
     if not maxwell:
         out[0] = H + G

@@ -764,10 +764,16 @@ class Stepper:
         if added:
             nodes.xi_max = max(nodes.xi_max, float(self._furthest[0]))
         if law.maxwell:
-            for i in inside.tolist():  # as _insert_new: the arms' memory on joining
-                nodes.D[i, :law.tau_arms.size] = (law.V @ nodes.Y[i, :law.n_modes] - ev.Hf
-                                                  - self.setup.indenter.g(float(nodes.xi[i])))
+            for i in inside.tolist():
+                nodes.D[i, :law.tau_arms.size] = self._joining_memory(nodes.Y[i], ev.Hf,
+                                                                      float(nodes.xi[i]))
         return True
+
+    def _joining_memory(self, Y, Hf, x):
+        """What the arms of an element at ``x`` with modes ``Y`` remember on joining the
+        contact with the filtered lift ``Hf``: ``D = E - Hf - g(x)``."""
+        law = self.setup.law
+        return law.V @ Y[:law.n_modes] - Hf - self.setup.indenter.g(x)
 
     def _commit_elements(self, step, ev, t1) -> None:
         """The step's elements committed in Python: captures, releases, new elements."""
@@ -803,8 +809,7 @@ class Stepper:
         D = np.zeros((xs.size, nodes.D.shape[1]))
         if law.maxwell:
             for j in np.nonzero(inside)[0]:
-                D[j, :law.tau_arms.size] = (law.V @ Ys[j, :law.n_modes] - ev.Hf
-                                            - self.setup.indenter.g(float(xs[j])))
+                D[j, :law.tau_arms.size] = self._joining_memory(Ys[j], ev.Hf, float(xs[j]))
         nodes.insert_many(xs, Ys, np.where(inside, st.CONTACT, st.FREE), D,
                           np.where(inside, t1, 0.0), t1)
 
@@ -821,9 +826,8 @@ class Stepper:
         law = self.setup.law
         xs = ev.xi[free]
         Y = np.array([np.interp(ev.alpha, xs, ev.Y[free][:, k]) for k in range(law.n_modes)])
-        D = law.V @ Y - ev.Hf - self.setup.indenter.g(ev.alpha)
         D_full = np.zeros(nodes.D.shape[1])
-        D_full[:law.tau_arms.size] = D
+        D_full[:law.tau_arms.size] = self._joining_memory(Y, ev.Hf, ev.alpha)
         nodes.insert(float(ev.alpha), Y, st.CONTACT, D=D_full, tj=t1, t_last=t1)
 
     def _driver_rate(self) -> float:

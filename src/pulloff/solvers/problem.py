@@ -80,17 +80,15 @@ class Problem:
     # --- SI views of a dimensionless time -------------------------------------------------
     def lift(self, t):
         """Punch lift ``h`` [m] at dimensionless time ``t``."""
-        if type(t) is float:  # (the same operations without numpy: every level's outputs)
-            return self.h0 + self.v * self.time_scale * t
-        return self.h0 + self.v * self.time_scale * np.asarray(t, dtype=float)
+        # (a float stays one: the same operations without numpy, every level's outputs)
+        t = t if type(t) is float else np.asarray(t, dtype=float)
+        return self.h0 + self.v * self.time_scale * t
 
     def zone_end(self, t):
         """Cohesive-zone end ``b`` [m] at dimensionless time ``t``."""
-        if type(t) is float:
-            s = self.s_of(t)
-            return self.a * math.sqrt(1.0 + s * s)
-        s = self.s_of(np.asarray(t, dtype=float))
-        return self.a * np.sqrt(1.0 + s * s)
+        scalar = type(t) is float
+        s = self.s_of(t if scalar else np.asarray(t, dtype=float))
+        return self.a * (math.sqrt if scalar else np.sqrt)(1.0 + s * s)
 
     def contact_force(self, t):
         """``F_contact = 8 a (G h + eta dh/dt)`` [N] (eq. 48)."""
