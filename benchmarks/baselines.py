@@ -25,8 +25,7 @@ import scipy.sparse
 from scipy.integrate import solve_ivp
 
 from pulloff.kernels import onset as kernels
-from pulloff.solvers.onset import (Problem, _crossing_time, frozen_detach_time, preloaded_mesh,
-                            step_weights)
+from pulloff.solvers.onset import Problem, frozen_detach_time, preloaded_mesh, step_weights
 
 
 # --------------------------------------------------------------------------------------------
@@ -191,7 +190,7 @@ def march_numpy(problem: Problem, dt: float, n_stop: int,
         t_out[step + 1] = t_new
         gap_out[step + 1] = g
         if g >= 1.0:
-            return _crossing_time(t_out, gap_out, step + 1)
+            return kernels.crossing_time(t_out[:step + 2], gap_out[:step + 2])
     return math.nan
 
 

@@ -78,12 +78,12 @@ def kernel_calls(problem: Problem, n: int):
     k, c, dt, S = a["k"], a["c"], a["dt"], a["S"]
     decay, w_old, w_new = kernels.linear_load_weights(k, c, dt)
     tables = (kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
-    fine = (kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS, kernels.TS_FINE_WEIGHTS)
     w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n + 2, *tables)
-    ratio, w_young, w_aged = kernels.age_interval_weights(k, c, dt, n + 2, *fine)
+    ratio, w_young, w_aged = kernels.age_interval_weights(k, c, dt, n + 2)
     moments = kernels.onset_moments(k, c, dt, *tables)
     born = np.arange(n + 1, dtype=np.int64)  # element j entered at step j
     no_cubic = np.zeros((1, 4))  # trapezoid/product weights, as in a run without a budget
+    scratch = np.empty(2 * n + 2)
     sig_pre, U_pre = a["sig_pre"], a["U_pre"]
     sig_born, U_born = a["sig_born"][:n], a["U_born"][:n]
     # For the gap integral: half the elements preloaded, half entered (n in total).
@@ -107,10 +107,11 @@ def kernel_calls(problem: Problem, n: int):
             w_on_new[:64], *moments), n),
         "displacement_integral": (lambda: kernels.displacement_integral(
             sig_p, off_p, U_p, dx_p, no_cubic, born, a["sig_born"], a["U_born"], dx_b,
-            no_cubic, n - half, n - half - 1, S, k * t_now, k * dt, ratio, w_young, w_aged),
+            no_cubic, n - half, n - half - 1, S, k * t_now, k * dt, ratio, w_young, w_aged,
+            scratch),
             n),
         "onset_weights": (lambda: kernels.onset_weights(k, c, dt, n, *tables), n),
-        "age_interval_weights": (lambda: kernels.age_interval_weights(k, c, dt, n, *fine), n),
+        "age_interval_weights": (lambda: kernels.age_interval_weights(k, c, dt, n), n),
     }
 
 
@@ -290,10 +291,8 @@ def report_simulate(alpha, chi):
              lambda: (kernels.onset_weights(problem.k, problem.c, t_ref / 200, 227,
                                             kernels.TS_NODES, kernels.TS_COMPLEMENTS,
                                             kernels.TS_WEIGHTS),
-                      kernels.age_interval_weights(problem.k, problem.c, t_ref / 200, 227,
-                                                   kernels.TS_FINE_NODES,
-                                                   kernels.TS_FINE_COMPLEMENTS,
-                                                   kernels.TS_FINE_WEIGHTS)))):
+                      kernels.age_interval_weights(problem.k, problem.c, t_ref / 200,
+                                                   227)))):
         call()
         timing, _ = time_call(call, min_repeats=MIN_REPEATS, min_total=MIN_TOTAL)
         out(f"    {label:<62} {1e3 * timing.median:7.3f} ms")

@@ -39,9 +39,6 @@ def _tanh_sinh_rule(step: float = _TS_STEP, half_width: float = _TS_HALF_WIDTH):
 
 
 TS_NODES, TS_COMPLEMENTS, TS_WEIGHTS = _tanh_sinh_rule()
-# A finer rule for the one scalar per run whose integrand has a layer as thin as c/(k dt).
-TS_FINE_NODES, TS_FINE_COMPLEMENTS, TS_FINE_WEIGHTS = _tanh_sinh_rule(step=1.0 / 128.0,
-                                                                      half_width=3.6)
 
 
 @njit(cache=True)
@@ -223,13 +220,83 @@ def onset_weight_pair(age, w_on_old, w_on_new, scale, m_old, m_new):
     return root * acc_old, root * acc_new
 
 
+#: :func:`onset_ratio` up to ``z = k age / c = RATIO_Z_LOW 2^RATIO_OCTAVES`` as Chebyshev
+#: series: ``k R = 1 - D(sqrt z) / sqrt z`` with ``D`` Dawson's integral is entire in ``z``;
+#: one series per octave of ``z`` from ``RATIO_Z_LOW`` (degree 20 leaves ~4e-15, the level of
+#: the power series it replaces), and below it ``k R / z`` (degree 12; ``1 - D/sqrt z``
+#: cancels there). The power series took 10-80 terms with two divisions each and made the
+#: product weights a third of a run's kernel time (0.15-0.45 ms at rtol 1e-6).
+RATIO_Z_LOW = 0.5
+RATIO_OCTAVES = 11
+RATIO_DEGREE = 20
+RATIO_NEAR_ZERO_DEGREE = 12
+
+
+def _ratio_octave_coefficients():
+    """Chebyshev coefficients (rows: octaves ``[Z 2^j, Z 2^(j+1)]``, ``Z = RATIO_Z_LOW``) of
+    ``1 - D(sqrt z) / sqrt z``, interpolated at Chebyshev points from scipy's ``dawsn``."""
+    from numpy.polynomial import chebyshev
+    from scipy.special import dawsn
+
+    rows = []
+    for j in range(RATIO_OCTAVES):
+        low = RATIO_Z_LOW * 2.0 ** j
+
+        def ratio(t, low=low):
+            root = np.sqrt(low * (1.5 + 0.5 * t))
+            return 1.0 - dawsn(root) / root
+        rows.append(chebyshev.chebinterpolate(ratio, RATIO_DEGREE))
+    return np.ascontiguousarray(rows)
+
+
+def _ratio_near_zero_coefficients():
+    """Chebyshev coefficients of ``k R / z = exp(-z) sum_n z^n / (n! (n + 3/2))`` on
+    ``[0, RATIO_Z_LOW]`` (the positive series, summed to rounding in Python)."""
+    from numpy.polynomial import chebyshev
+
+    def series(z):
+        total, term, n = 0.0, 1.0, 0
+        while term >= 1e-18 * total or n <= z:
+            total += term / (n + 1.5)
+            n += 1
+            term *= z / n
+        return math.exp(-z) * total
+
+    return chebyshev.chebinterpolate(
+        lambda t: np.array([series(0.5 * RATIO_Z_LOW * (1.0 + x)) for x in np.atleast_1d(t)]),
+        RATIO_NEAR_ZERO_DEGREE)
+
+
+RATIO_CHEBYSHEV = _ratio_octave_coefficients()
+RATIO_NEAR_ZERO = _ratio_near_zero_coefficients()
+
+
+@njit(cache=True)
+def _clenshaw(coefficients, t):
+    """The Chebyshev series with ``coefficients`` at ``t`` in ``[-1, 1]``."""
+    b1 = b2 = 0.0
+    for i in range(coefficients.shape[0] - 1, 0, -1):
+        b1, b2 = coefficients[i] + 2.0 * t * b1 - b2, b1
+    return coefficients[0] + t * b1 - b2
+
+
+@njit(cache=True)
+def _ratio_chebyshev(z):
+    """``k R`` at ``RATIO_Z_LOW <= z < RATIO_Z_LOW 2^RATIO_OCTAVES`` (Clenshaw's recurrence on
+    the octave's series)."""
+    mantissa, exponent = math.frexp(z / RATIO_Z_LOW)  # z / Z = mantissa 2^exponent
+    # (mantissa in [0.5, 1) onto [-1, 1))
+    return _clenshaw(RATIO_CHEBYSHEV[exponent - 1], 4.0 * mantissa - 3.0)
+
+
 @njit(cache=True)
 def onset_ratio(age, k, c):
     """``U / q`` of an element of the given age whose load grew like ``sqrt(age)``.
 
     With ``F(age) = (1/c) int_0^age exp(-(k/c)(age - a)) sqrt(a) da`` this is
     ``F(age) / sqrt(age)``: 0 at entry, ``1/k`` once the element has relaxed, with a layer of
-    width ``c/k`` in between. Positive series below 40 relaxation times, the asymptotic
+    width ``c/k`` in between. With ``z = k age / c``: Chebyshev series (see
+    ``RATIO_CHEBYSHEV``) up to ``RATIO_Z_LOW 2^RATIO_OCTAVES``, the asymptotic
     (quasi-static) expansion ``(1/k) sum_n a_n (c / (k age))^n`` beyond.
     """
     if c == 0.0:
@@ -237,18 +304,11 @@ def onset_ratio(age, k, c):
     if k == 0.0:
         return 2.0 * age / (3.0 * c)
     z = k * age / c
-    if z <= 40.0:
+    if z < RATIO_Z_LOW:
         # exp(-z) int_0^1 exp(z w) sqrt(w) dw = exp(-z) sum_n z^n / (n! (n + 3/2))
-        total = 0.0
-        term = 1.0
-        n = 0
-        while True:
-            total += term / (n + 1.5)
-            n += 1
-            term *= z / n
-            if term < 1e-17 * total and n > z:
-                break
-        return age / c * math.exp(-z) * total
+        return age / c * _clenshaw(RATIO_NEAR_ZERO, 2.0 * z / RATIO_Z_LOW - 1.0)
+    if z < RATIO_Z_LOW * 2.0 ** RATIO_OCTAVES:
+        return _ratio_chebyshev(z) / k
     total = 1.0
     coeff = 1.0
     inv = 1.0 / z
@@ -259,17 +319,44 @@ def onset_ratio(age, k, c):
         power *= inv
         term = coeff * power
         total += term
-        if abs(term) < 1e-17 or n + 1 > 0.5 * z:
+        if abs(term) < 1e-17:
             break
     return total / k
 
 
-
-
+# 12-point Gauss-Legendre on [0, 1] for the octaves of the youngest interval.
+_GL12_X, _GL12_W = np.polynomial.legendre.leggauss(12)
+_GL12_X = 0.5 * (_GL12_X + 1.0)
+_GL12_W = 0.5 * _GL12_W
 
 
 @njit(cache=True)
-def age_interval_weights(k, c, dt, n_ages, nodes, complements, weights):
+def _youngest_interval_weights(k, c, dt):
+    """``int_0^1 R(z dt) {1 - z, z} dz`` where the relaxation layer ``c / k`` is thinner than
+    the step: panels ``[0, w]``, then octaves ``[w, 2w], [2w, 4w], ..`` to 1, ``w = c/(k dt)``.
+    ``R`` is entire in the age and, on an octave, no nearer its singular scale than the
+    octave's own width, so 12 points per panel reach rounding (measured against a 923-point
+    tanh-sinh rule for ``k dt / c`` from 0.6 to 1e8: within 9e-16), with ``12 log2(k dt/c)``
+    evaluations instead of 923."""
+    if c == 0.0:
+        return 0.5 / k, 0.5 / k  # elastic: R = 1/k from the first instant
+    acc_y = acc_o = 0.0
+    low = 0.0
+    high = min(1.0, c / (k * dt))
+    while low < 1.0:
+        width = high - low
+        for i in range(_GL12_X.shape[0]):
+            z = low + width * _GL12_X[i]
+            r = width * _GL12_W[i] * onset_ratio(z * dt, k, c)
+            acc_y += r * (1.0 - z)
+            acc_o += r * z
+        low = high
+        high = min(1.0, 2.0 * high)
+    return acc_y, acc_o
+
+
+@njit(cache=True)
+def age_interval_weights(k, c, dt, n_ages):
     """Product-integration weights of ``U/q`` between element ages ``m dt`` and ``(m+1) dt``.
 
     Between neighbouring entered elements ``U/q = g(age) R(age)`` with ``R`` the universal
@@ -288,11 +375,7 @@ def age_interval_weights(k, c, dt, n_ages, nodes, complements, weights):
         acc_y = 0.0
         acc_o = 0.0
         if m == 0 and k * dt > _SMOOTH_FIRST_INTERVAL * c:
-            # The layer sits inside the youngest interval: tanh-sinh clusters at age 0.
-            for i in range(nodes.shape[0]):
-                r = onset_ratio(nodes[i] * dt, k, c)
-                acc_y += weights[i] * r * complements[i]
-                acc_o += weights[i] * r * nodes[i]
+            acc_y, acc_o = _youngest_interval_weights(k, c, dt)
         else:
             for i in range(_GL_X.shape[0]):
                 r = onset_ratio((m + _GL_X[i]) * dt, k, c)
@@ -301,6 +384,34 @@ def age_interval_weights(k, c, dt, n_ages, nodes, complements, weights):
         w_young[m] = acc_y
         w_old[m] = acc_o
     return ratio, w_young, w_old
+
+
+@njit(cache=True)
+def step_tables(k, c, dt, n_tab, beyond_tables):
+    """Every weight of one step size, in the order :func:`march` takes them: ``(decay,
+    w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new, ratio,
+    w_young, w_old)``, tabulated for ages below ``n_tab``; the moments of
+    :func:`onset_moments` only where elements grow ``beyond_tables`` (zeros otherwise, and
+    tables of zeros when ``k = 0``: no element ever enters). One compiled call per level: as
+    five calls from Python it cost ~10 us of a ~100 us level."""
+    decay, w_pre_old, w_pre_new = linear_load_weights(k, c, dt)
+    m_old = np.zeros(BINOM_HALF.shape[0])
+    m_new = np.zeros(BINOM_HALF.shape[0])
+    scale = 0.0
+    if k > 0.0:
+        w_on_old, w_on_new = onset_weights(k, c, dt, n_tab, TS_NODES, TS_COMPLEMENTS,
+                                           TS_WEIGHTS)
+        if beyond_tables:
+            scale, m_old, m_new = onset_moments(k, c, dt, TS_NODES, TS_COMPLEMENTS, TS_WEIGHTS)
+        ratio, w_young, w_old = age_interval_weights(k, c, dt, n_tab)
+    else:
+        w_on_old = np.zeros(n_tab)
+        w_on_new = np.zeros(n_tab)
+        ratio = np.zeros(n_tab + 1)
+        w_young = np.zeros(n_tab)
+        w_old = np.zeros(n_tab)
+    return (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio,
+            w_young, w_old)
 
 
 @njit(cache=True)
@@ -420,7 +531,8 @@ def preloaded_cubic_weights(dx_pre):
 
 @njit(cache=True)
 def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
-                          dx_born, thin_w, n_born, step, S, kt, k_dt, ratio, w_young, w_old):
+                          dx_born, thin_w, n_born, step, S, kt, k_dt, ratio, w_young, w_old,
+                          scratch):
     """``int_1^b U(x) / sqrt(b^2 - x^2) dx`` over the free zone (units of ``delta``).
 
     The field is written ``U = sqrt(b^2 - x^2) v(x)``, so no quadrature node sits on the
@@ -439,10 +551,53 @@ def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_b
     once, not every step. ``S - sigma`` comes from exact offsets: ``offset_pre + k t`` for
     preloaded elements, ``k dt age`` for entered ones (``kt``, ``k_dt``); ``born[0]`` is 0.
     """
+    if (pre_w.shape[0] != sig_pre.shape[0] + 1 and n_born > 1 and born[n_born - 1] == step
+            and step - born[0] == n_born - 1 and step - born[0] < w_young.shape[0]):
+        # (a ladder's level: no budget, every element consecutive and within the tables)
+        return (_preloaded_trapezoid(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, S,
+                                     kt, scratch)
+                + _entered_consecutive(born, sig_born, U_born, dx_born, n_born, step, S, k_dt,
+                                       ratio, w_young, w_old, scratch))
     return (_preloaded_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, sig_born, U_born,
                                 n_born, S, kt)
             + _entered_integral(born, sig_born, U_born, dx_born, thin_w, n_born, step, S, k_dt,
                                 ratio, w_young, w_old))
+
+
+@njit(cache=True, error_model="numpy")
+def _preloaded_trapezoid(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, S, kt,
+                         scratch):
+    """:func:`_preloaded_integral` with the trapezoid on ``v`` and an entered element beyond
+    the oldest (the same operations in the same order): ``v`` first in a loop without
+    dependences, which LLVM vectorises (numpy's error model: no division check), then the
+    sum."""
+    n_pre = sig_pre.shape[0]
+    for i in range(n_pre):
+        scratch[i] = U_pre[i] / math.sqrt((offset_pre[i] + kt) * (S + sig_pre[i]))
+    scratch[n_pre] = U_born[0] / math.sqrt(kt * (S + sig_born[0]))
+    total = 0.0
+    for i in range(1, n_pre + 1):
+        total += 0.5 * (scratch[i] + scratch[i - 1]) * dx_pre[i]
+    return total
+
+
+@njit(cache=True, error_model="numpy")
+def _entered_consecutive(born, sig_born, U_born, dx_born, n_born, step, S, k_dt, ratio,
+                         w_young, w_old, scratch):
+    """:func:`_entered_integral` where elements ``0 .. n_born - 1`` entered on consecutive
+    steps and all are younger than the tables (the same operations in the same order): ``g``
+    first in a loop without dependences, which LLVM vectorises, then the sum."""
+    top = step - born[0]  # the oldest age; element j is top - j steps old
+    n_aged = n_born - 1  # the youngest (age 0) takes g from its older neighbour
+    for j in range(n_aged):
+        v = U_born[j] / math.sqrt(k_dt * (top - j) * (S + sig_born[j]))
+        scratch[j] = v / ratio[top - j]
+    scratch[n_aged] = scratch[n_aged - 1]
+    total = 0.0
+    for j in range(1, n_born):
+        age = top - j
+        total += dx_born[j] * (scratch[j] * w_young[age] + scratch[j - 1] * w_old[age])
+    return total
 
 
 @njit(cache=True)
@@ -570,6 +725,48 @@ def gap_from_integral(h, S, integral):
     return (2.0 / math.pi) * (h * math.atan(S) - integral)
 
 
+@njit(cache=True)
+def crossing_time(t, gap):
+    """Time where the gap reaches 1 in the last step of the rows ``t``, ``gap`` (the last
+    four, or fewer when the run has fewer; fourth-order local interpolation).
+
+    The cubic through the last four points leaves a location error ``O(dt^4)``: below the
+    stepper's own error and below the ``dt^3`` term that its Richardson extrapolation leaves,
+    which a quadratic's error (``O(dt^3)``, with a constant that jumps with where in the step
+    the crossing falls) would otherwise make irregular. Newton from the linear guess, kept
+    inside the step. Compiled: in Python it was ~12 us of a ~100 us level.
+    """
+    m = min(4, t.shape[0])
+    ts = t[t.shape[0] - m:].copy()
+    coef = gap[gap.shape[0] - m:].copy()
+    t1, t2, g1, g2 = ts[m - 2], ts[m - 1], coef[m - 2], coef[m - 1]
+    t_lin = t1 + (1.0 - g1) * (t2 - t1) / (g2 - g1)
+    if m < 3:
+        return t_lin
+    # Newton's divided differences through the points, centred on the step.
+    for i in range(m):
+        ts[i] -= t2
+    for j in range(1, m):
+        for i in range(m - 1, j - 1, -1):
+            coef[i] = (coef[i] - coef[i - 1]) / (ts[i] - ts[i - j])
+    x = t_lin - t2
+    for _ in range(30):
+        value = coef[m - 1]
+        slope = 0.0
+        for j in range(m - 2, -1, -1):
+            slope = slope * (x - ts[j]) + value
+            value = value * (x - ts[j]) + coef[j]
+        if slope <= 0.0:
+            return t_lin
+        x_new = x - (value - 1.0) / slope
+        if not t1 - t2 <= x_new <= 0.0:
+            return t_lin
+        if abs(x_new - x) <= 1e-15 * (abs(t2) + abs(x_new)):
+            return t2 + x_new
+        x = x_new
+    return t2 + x
+
+
 #: Return codes of :func:`march`.
 MARCH_STOPPED = 0
 MARCH_CROSSED = 1
@@ -594,6 +791,7 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
     """
     capacity = sig_born.shape[0]
     n_tab = w_on_old.shape[0]
+    scratch = np.empty(max(sig_pre.shape[0] + 1, capacity))
     while step < step_stop:
         if k > 0.0 and n_born >= capacity:
             return step, n_born, MARCH_FULL
@@ -620,15 +818,44 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
             dx_born[n_born] = interval_width(sig_born[n_born - 1], s_new)
             n_born += 1
         integral = displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born,
-                                         sig_born,
-                                         U_born, dx_born, thin_w, n_born, step, s_new,
-                                         k * t_new, k * dt, ratio, w_young, w_old)
+                                         sig_born, U_born, dx_born, thin_w, n_born, step, s_new,
+                                         k * t_new, k * dt, ratio, w_young, w_old, scratch)
         g = gap_from_integral(h0 + t_new, s_new, integral)
         t_out[step - row0] = t_new
         gap_out[step - row0] = g
         if g >= 1.0:
             return step, n_born, MARCH_CROSSED
     return step, n_born, MARCH_STOPPED
+
+
+@njit(cache=True)
+def run_level(k, c, h0, dt, n_stop, n_pre, n_tab, beyond_tables, gap0):
+    """A whole level of the onset ladder in one call: the zone loaded at ``t = 0`` on
+    ``n_pre`` nodes (:func:`preloaded_state`), the weights (:func:`step_tables`, ages below
+    ``n_tab``), and :func:`march` from the gap ``gap0`` at ``t = 0`` to the crossing or
+    ``n_stop`` steps, every element kept (no budget). Returns ``(t, gap, step, n_elements,
+    code)`` with the rows ``0 .. step`` in ``t`` and ``gap``. What
+    ``solvers.onset.run_foundation`` does for such a level, without Python between the
+    kernels."""
+    s0 = k * (h0 + 0.0) + c
+    sig_pre, offset_pre, U_pre, dx_pre = preloaded_state(s0, n_pre, k, c)
+    no_cubic = np.zeros((1, 4))
+    capacity = n_stop + 2
+    born = np.zeros(capacity, dtype=np.int64)
+    sig_born = np.zeros(capacity)
+    U_born = np.zeros(capacity)
+    dx_born = np.zeros(capacity)
+    sig_born[0] = s0
+    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio, w_young,
+     w_old) = step_tables(k, c, dt, n_tab, beyond_tables)
+    t_rows = np.zeros(n_stop + 1)
+    gap_rows = np.zeros(n_stop + 1)
+    gap_rows[0] = gap0
+    step, n_born, code = march(sig_pre, offset_pre, U_pre, dx_pre, no_cubic, born, sig_born,
+                               U_born, dx_born, no_cubic, 1, 0, 0, n_stop, k, c, h0, dt, decay,
+                               w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new,
+                               ratio, w_young, w_old, t_rows, gap_rows, 0)
+    return t_rows, gap_rows, step, sig_pre.shape[0] + n_born, code
 
 
 # --------------------------------------------------------------------------------------------

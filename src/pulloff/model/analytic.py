@@ -24,6 +24,8 @@ therefore not an identity, but eq. 74 and everything derived from it (eqs. 75-83
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import json
 import math
 from fractions import Fraction
@@ -614,13 +616,36 @@ def _cohesive_bracket(S):
     """``(1 + S^2) atan(S) - S`` for an array ``S >= 0``, to ~1e-15 relative."""
     S = np.asarray(S, dtype=float)
     small = S < _COH_SERIES_MAX_S
-    Ss = np.where(small, S, 0.0)
-    s2 = Ss * Ss
-    series = Ss * s2 * _horner(_COH_SERIES, s2)
-    Sl = np.where(small, 1.0, S)
+    if small.all():  # (a thin zone's whole history: no masks)
+        return _cohesive_series(S)
     with np.errstate(over="ignore", invalid="ignore"):
-        direct = (1.0 + Sl * Sl) * np.arctan(Sl) - Sl
-    return np.where(small, series, direct)
+        out = (1.0 + S * S) * np.arctan(S) - S
+    if small.any():
+        out[small] = _cohesive_series(S[small])
+    return out
+
+
+def _cohesive_series(S):
+    s2 = S * S
+    return S * s2 * _horner(_COH_SERIES[:_series_terms(float(s2.max()))], s2)
+
+
+def _series_terms(s2_max: float) -> int:
+    """Terms of ``_COH_SERIES`` whose sum is exact to rounding for ``S^2 <= s2_max``: the
+    first omitted one is below 2^-56 of the leading ``2/3`` (all 30 at ``S = 0.5``; 5 for the
+    thin zones of a run's history, where 30 over every row were most of its SI columns, and
+    whose powers would otherwise reach subnormal numbers)."""
+    return min(len(_COH_SERIES), bisect.bisect_left(_COH_SERIES_REACH, s2_max) + 1)
+
+
+def _series_reach():
+    """``S^2`` up to which the first ``n + 1`` terms of ``_COH_SERIES`` suffice (ascending)."""
+    reach = [(2.0 ** -56 * _COH_SERIES[0] / abs(c)) ** (1.0 / n)
+             for n, c in enumerate(_COH_SERIES) if n > 0]
+    return list(itertools.accumulate(reach, max))
+
+
+_COH_SERIES_REACH = _series_reach()
 
 
 def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:

@@ -65,45 +65,6 @@ class FoundationRun:
     n_thinned: int = 0  # times the element arrays were full and thinned
 
 
-def _crossing_time(t: np.ndarray, gap: np.ndarray, n: int) -> float:
-    """Time where the gap reaches 1 inside step ``n`` (fourth-order local interpolation).
-
-    The cubic through the last four points (fewer when the run has fewer) leaves a location
-    error ``O(dt^4)``: below the stepper's own error and below the ``dt^3`` term that its
-    Richardson extrapolation leaves, which a quadratic's error (``O(dt^3)``, with a constant
-    that jumps with where in the step the crossing falls) would otherwise make irregular.
-    Newton from the linear guess, kept inside the step.
-    """
-    first = max(0, n - 3)
-    t_pts = t[first:n + 1].tolist()
-    coef = gap[first:n + 1].tolist()
-    t1, t2, g1, g2 = t_pts[-2], t_pts[-1], coef[-2], coef[-1]
-    t_lin = t1 + (1.0 - g1) * (t2 - t1) / (g2 - g1)
-    m = len(t_pts)
-    if m < 3:
-        return t_lin
-    # Newton's divided differences through the points first..n, centred on the step.
-    ts = [x - t2 for x in t_pts]
-    for j in range(1, m):
-        for i in range(m - 1, j - 1, -1):
-            coef[i] = (coef[i] - coef[i - 1]) / (ts[i] - ts[i - j])
-    x = t_lin - t2
-    for _ in range(30):
-        value, slope = coef[-1], 0.0
-        for j in range(m - 2, -1, -1):
-            slope = slope * (x - ts[j]) + value
-            value = value * (x - ts[j]) + coef[j]
-        if slope <= 0.0:
-            return t_lin
-        x_new = x - (value - 1.0) / slope
-        if not t1 - t2 <= x_new <= 0.0:
-            return t_lin
-        if abs(x_new - x) <= 1e-15 * (abs(t2) + abs(x_new)):
-            return t2 + x_new
-        x = x_new
-    return t2 + x
-
-
 def preloaded_mesh(s0: float, n: int):
     """Nodes ``sigma`` (ascending, from 0) of the zone loaded at ``t = 0`` and ``s0 - sigma``.
 
@@ -131,29 +92,15 @@ def step_weights(k: float, c: float, dt: float, n_ages: int):
     ``(decay, w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new,
     ratio, w_young, w_old)``, tabulated for element ages up to ``min(n_ages, _TABLE_AGES)``
     steps (tables of zeros when ``k = 0``: no element ever enters)."""
-    # A run shorter than the expansion's first age never needs it: its tables cover every age.
-    n_tab = (n_ages if n_ages <= kernels.ONSET_ASYMPTOTIC_AGE
-             else max(kernels.ONSET_ASYMPTOTIC_AGE, min(n_ages, _TABLE_AGES)))
-    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
-    rule = (kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
-    if k > 0.0:
-        w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_tab, *rule)
-        if n_tab >= n_ages:  # the tables reach every age: the expansion is never used
-            scale, m_old, m_new = 0.0, np.zeros(kernels.BINOM_HALF.size), np.zeros(
-                kernels.BINOM_HALF.size)
-        else:
-            scale, m_old, m_new = kernels.onset_moments(k, c, dt, *rule)
-        ratio, w_young, w_old = kernels.age_interval_weights(
-            k, c, dt, n_tab, kernels.TS_FINE_NODES, kernels.TS_FINE_COMPLEMENTS,
-            kernels.TS_FINE_WEIGHTS)
-    else:
-        w_on_old = w_on_new = np.zeros(n_tab)
-        scale, m_old, m_new = 0.0, np.zeros(kernels.BINOM_HALF.size), np.zeros(
-            kernels.BINOM_HALF.size)
-        ratio = np.zeros(n_tab + 1)
-        w_young = w_old = np.zeros(n_tab)
-    return (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio,
-            w_young, w_old)
+    n_tab = _table_ages(n_ages)
+    return kernels.step_tables(k, c, dt, n_tab, n_tab < n_ages)
+
+
+def _table_ages(n_ages: int) -> int:
+    """Ages tabulated for a run whose elements reach ``n_ages`` steps: all of them, up to
+    ``_TABLE_AGES`` (a run shorter than the expansion's first age never needs it)."""
+    return (n_ages if n_ages <= kernels.ONSET_ASYMPTOTIC_AGE
+            else max(kernels.ONSET_ASYMPTOTIC_AGE, min(n_ages, _TABLE_AGES)))
 
 
 class _History:
@@ -213,6 +160,10 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
     state. The history keeps every ``record_every``-th step in memory and hands every
     ``stream_every``-th to ``stream`` (a callable taking :func:`si_history` columns).
     """
+    if (not snapshot_times and progress is None and record_every == 1
+            and max_elements is None and stream is None and 0 < n_stop <= _MIN_CHUNK
+            and _start_gap(problem) < 1.0):
+        return _ladder_level(problem, dt, n_stop, n_preloaded)
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
     s0 = problem.s_of(0.0)
     sig_pre, offset_pre, U_pre, dx_pre, pre_w = _preloaded(problem, dt, n_stop, n_preloaded,
@@ -269,12 +220,29 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
         # updated, so the arrays and the history hold a consistent state up to ``step``.
         interrupted = True
     t_tail, gap_tail = history.tail
-    t_detach = _crossing_time(t_tail, gap_tail, t_tail.size - 1) if crossed else math.nan
+    t_detach = kernels.crossing_time(t_tail, gap_tail) if crossed else math.nan
     t_end = t_detach if crossed else step * dt
     snapshots = _snapshots(problem, wanted, captured, dt, t_end)
     steps, t, gap = history.arrays(dt, step)
     return FoundationRun(dt, t, gap, t_detach, sig_pre.size + n_born, step, snapshots,
                          interrupted, steps=steps, n_thinned=n_thinned)
+
+
+def _ladder_level(problem: Problem, dt: float, n_stop: int, n_preloaded) -> FoundationRun:
+    """:func:`run_foundation` of a ladder's level (one kernel call, every row kept, nothing
+    observed) as one compiled call, :func:`pulloff.kernels.onset.run_level`: the same
+    kernels, rows and crossing, without ~40 us of Python per level (a third of a run at rtol
+    1e-6 went to the Python around its five levels)."""
+    n_tab = _table_ages(n_stop + 2)
+    t_rows, gap_rows, step, n_elements, code = kernels.run_level(
+        problem.k, problem.c, problem.h0_scaled, dt, n_stop,
+        _preloaded_count(problem, dt, n_stop, n_preloaded, None), n_tab, n_tab < n_stop + 2,
+        _start_gap(problem))
+    steps = np.arange(step + 1)
+    t_detach = (kernels.crossing_time(t_rows[:step + 1], gap_rows[:step + 1])
+                if code == kernels.MARCH_CROSSED else math.nan)
+    return FoundationRun(dt, steps * dt, gap_rows[:step + 1], t_detach, n_elements, step,
+                         steps=steps)
 
 
 @functools.lru_cache(maxsize=256)
@@ -315,10 +283,7 @@ def _preloaded(problem: Problem, dt: float, n_stop: int, n_preloaded, max_elemen
     bounds them to a quarter of it: the mesh then stops refining with the step)."""
     k, c = problem.k, problem.c
     s0 = problem.s_of(0.0)
-    s_ref = problem.s_of(n_stop * dt)
-    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
-    if max_elements is not None:
-        n_pre = min(n_pre, max(8, int(max_elements) // 4))
+    n_pre = _preloaded_count(problem, dt, n_stop, n_preloaded, max_elements)
     # An elastic element follows its load at once, also the step lift h0 at t = 0; a damper
     # cannot move instantly (MODEL.md: u(x,0) = 0).
     sig_pre, offset_pre, U_pre, dx_pre = kernels.preloaded_state(float(s0), n_pre, k, c)
@@ -327,6 +292,16 @@ def _preloaded(problem: Problem, dt: float, n_stop: int, n_preloaded, max_elemen
     pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
              and sig_pre.size >= 3 else np.zeros((1, 4)))
     return sig_pre, offset_pre, U_pre, dx_pre, pre_w
+
+
+def _preloaded_count(problem: Problem, dt: float, n_stop: int, n_preloaded,
+                     max_elements) -> int:
+    """Elements in the zone loaded at ``t = 0`` (see :func:`_preloaded`)."""
+    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * problem.s_of(0.0)
+                                                / problem.s_of(n_stop * dt))))
+    if max_elements is not None:
+        n_pre = min(n_pre, max(8, int(max_elements) // 4))
+    return n_pre
 
 
 def _snapshots(problem: Problem, wanted: dict, captured: dict, dt: float, t_end: float):
