@@ -323,7 +323,7 @@ def _t_star_scalar(al):
 
 
 def _t_over_alpha_series(al):
-    return _horner(_T_OVER_ALPHA_SERIES, np.float64(al)).item()
+    return _horner_scalar(_T_OVER_ALPHA_SERIES, float(al))
 
 
 def seed_t_star(alpha):
@@ -510,7 +510,7 @@ def _g_gap(S):
     """``g(S) = S atan(S) - (sqrt(1+S^2) - 1)``: the elastic gap at r = b in units sigma_c a/(pi G)."""
     if S < _G_SERIES_MAX_S:
         s2 = S * S
-        return s2 * _horner(_G_SERIES, np.float64(s2)).item()
+        return s2 * _horner_scalar(_G_SERIES, float(s2))
     return S * math.atan(S) - S * S / (1.0 + math.sqrt(1.0 + S * S))
 
 
@@ -655,7 +655,7 @@ def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
     S = math.sqrt((b - a) * (b + a)) / a
     if S < _COH_SERIES_MAX_S:
         s2 = S * S
-        bracket = S * s2 * _horner_scalar(_COH_SERIES, s2)
+        bracket = S * s2 * _horner_scalar(_COH_SERIES[:_series_terms(s2)], s2)
     else:
         bracket = (1.0 + S * S) * math.atan(S) - S
     return 2.0 * sigma_c * a * a * bracket
