@@ -8,6 +8,7 @@ Lengths along the foundation in units of the punch radius ``a``, displacements, 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -18,7 +19,8 @@ from ..model import analytic
 
 @dataclass(frozen=True)
 class Problem:
-    """A flat-punch pull (SI in the fields, dimensionless through the properties)."""
+    """A flat-punch pull (SI in the fields, dimensionless through the properties; the
+    scalar ones computed once: an onset run reads them ~20 times)."""
 
     G: float  # Pa (the relaxed modulus G_inf of a Maxwell solid)
     eta: float  # Pa s
@@ -48,22 +50,22 @@ class Problem:
         """Dimensionless relaxation times ``tau_i v / delta`` of the Maxwell arms."""
         return np.array([tau / self.time_scale for _, tau in self.arms])
 
-    @property
+    @functools.cached_property
     def k(self) -> float:
         """Dimensionless foundation stiffness ``2 G delta / (sigma_c a)``."""
         return 2.0 * self.G * self.delta / (self.sigma_c * self.a)
 
-    @property
+    @functools.cached_property
     def c(self) -> float:
         """Dimensionless foundation damping ``2 eta v / (sigma_c a)``."""
         return 2.0 * self.eta * self.v / (self.sigma_c * self.a)
 
-    @property
+    @functools.cached_property
     def time_scale(self) -> float:
         """``T = delta / v`` [s]: the time to lift the punch by one Dugdale length."""
         return self.delta / self.v
 
-    @property
+    @functools.cached_property
     def h0_scaled(self) -> float:
         return self.h0 / self.delta
 
