@@ -72,6 +72,26 @@ def test_sweep_rows_equal_single_runs_and_run_in_parallel(seed):
     assert np.all(t["status"] == "ok") and np.all(t["detached"])
 
 
+def test_parallel_batches_give_every_row_once_as_one_process_does(seed, monkeypatch):
+    """Worker processes take growing batches of scenes (here up to MAX_BATCH from the second
+    round); every row arrives once, equal to the in-process sweep's."""
+    monkeypatch.setattr(sw, "BATCH_SECONDS", 1.0)
+    axes = ["loading.v=log:1e-4:1e-2:40", "numerics.rtol=1e-3"]
+    parallel = sw.sweep(seed, axes, workers=2).table
+    alone = sw.sweep(seed, axes, workers=1).table
+    assert parallel["index"].tolist() == list(range(40))
+    assert parallel["F_contact_detach"].tolist() == alone["F_contact_detach"].tolist()
+    assert np.all(parallel["status"] == "ok")
+
+
+def test_batch_size_follows_the_run_times_of_a_finished_batch():
+    ok = [(0, {"wall_time": 0.002}), (1, {"wall_time": 0.003})]
+    assert sw._batch_size(ok, 1) == int(sw.BATCH_SECONDS * 2 / (0.002 + 0.003))
+    assert sw._batch_size([(0, {"wall_time": 1e-9})], 1) == sw.MAX_BATCH
+    assert sw._batch_size([(0, {"wall_time": 10.0})], 7) == 1
+    assert sw._batch_size([(0, {"status": "failed"})], 7) == 7  # nothing timed: unchanged
+
+
 def test_a_failing_scene_is_a_row_and_the_sweep_goes_on(seed):
     t = sw.sweep(seed, ["loading.v=1e-3,-1,2e-3"], workers=1).table
     assert list(t["status"]) == ["ok", "failed", "ok"]

@@ -387,34 +387,6 @@ def age_interval_weights(k, c, dt, n_ages):
 
 
 @njit(cache=True)
-def step_tables(k, c, dt, n_tab, beyond_tables):
-    """Every weight of one step size, in the order :func:`march` takes them: ``(decay,
-    w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new, ratio,
-    w_young, w_old)``, tabulated for ages below ``n_tab``; the moments of
-    :func:`onset_moments` only where elements grow ``beyond_tables`` (zeros otherwise, and
-    tables of zeros when ``k = 0``: no element ever enters). One compiled call per level: as
-    five calls from Python it cost ~10 us of a ~100 us level."""
-    decay, w_pre_old, w_pre_new = linear_load_weights(k, c, dt)
-    m_old = np.zeros(BINOM_HALF.shape[0])
-    m_new = np.zeros(BINOM_HALF.shape[0])
-    scale = 0.0
-    if k > 0.0:
-        w_on_old, w_on_new = onset_weights(k, c, dt, n_tab, TS_NODES, TS_COMPLEMENTS,
-                                           TS_WEIGHTS)
-        if beyond_tables:
-            scale, m_old, m_new = onset_moments(k, c, dt, TS_NODES, TS_COMPLEMENTS, TS_WEIGHTS)
-        ratio, w_young, w_old = age_interval_weights(k, c, dt, n_tab)
-    else:
-        w_on_old = np.zeros(n_tab)
-        w_on_new = np.zeros(n_tab)
-        ratio = np.zeros(n_tab + 1)
-        w_young = np.zeros(n_tab)
-        w_old = np.zeros(n_tab)
-    return (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio,
-            w_young, w_old)
-
-
-@njit(cache=True)
 def step_preloaded(sigma, offset, U, kt_old, kt_new, s_old, s_new, decay, w_old, w_new):
     """Advance the elements that were inside the zone at ``t = 0`` by one step (in place).
 
@@ -826,36 +798,6 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
         if g >= 1.0:
             return step, n_born, MARCH_CROSSED
     return step, n_born, MARCH_STOPPED
-
-
-@njit(cache=True)
-def run_level(k, c, h0, dt, n_stop, n_pre, n_tab, beyond_tables, gap0):
-    """A whole level of the onset ladder in one call: the zone loaded at ``t = 0`` on
-    ``n_pre`` nodes (:func:`preloaded_state`), the weights (:func:`step_tables`, ages below
-    ``n_tab``), and :func:`march` from the gap ``gap0`` at ``t = 0`` to the crossing or
-    ``n_stop`` steps, every element kept (no budget). Returns ``(t, gap, step, n_elements,
-    code)`` with the rows ``0 .. step`` in ``t`` and ``gap``. What
-    ``solvers.onset.run_foundation`` does for such a level, without Python between the
-    kernels."""
-    s0 = k * (h0 + 0.0) + c
-    sig_pre, offset_pre, U_pre, dx_pre = preloaded_state(s0, n_pre, k, c)
-    no_cubic = np.zeros((1, 4))
-    capacity = n_stop + 2
-    born = np.zeros(capacity, dtype=np.int64)
-    sig_born = np.zeros(capacity)
-    U_born = np.zeros(capacity)
-    dx_born = np.zeros(capacity)
-    sig_born[0] = s0
-    (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new, ratio, w_young,
-     w_old) = step_tables(k, c, dt, n_tab, beyond_tables)
-    t_rows = np.zeros(n_stop + 1)
-    gap_rows = np.zeros(n_stop + 1)
-    gap_rows[0] = gap0
-    step, n_born, code = march(sig_pre, offset_pre, U_pre, dx_pre, no_cubic, born, sig_born,
-                               U_born, dx_born, no_cubic, 1, 0, 0, n_stop, k, c, h0, dt, decay,
-                               w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new,
-                               ratio, w_young, w_old, t_rows, gap_rows, 0)
-    return t_rows, gap_rows, step, sig_pre.shape[0] + n_born, code
 
 
 # --------------------------------------------------------------------------------------------

@@ -93,7 +93,22 @@ def step_weights(k: float, c: float, dt: float, n_ages: int):
     ratio, w_young, w_old)``, tabulated for element ages up to ``min(n_ages, _TABLE_AGES)``
     steps (tables of zeros when ``k = 0``: no element ever enters)."""
     n_tab = _table_ages(n_ages)
-    return kernels.step_tables(k, c, dt, n_tab, n_tab < n_ages)
+    decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
+    if k == 0.0:
+        zeros = np.zeros(n_tab)
+        return (decay, w_pre_old, w_pre_new, zeros, zeros, 0.0, _NO_MOMENTS, _NO_MOMENTS,
+                np.zeros(n_tab + 1), zeros, zeros)
+    rule = (kernels.TS_NODES, kernels.TS_COMPLEMENTS, kernels.TS_WEIGHTS)
+    w_on_old, w_on_new = kernels.onset_weights(k, c, dt, n_tab, *rule)
+    # The expansion beyond the tables, only where elements grow older than them.
+    scale, m_old, m_new = (kernels.onset_moments(k, c, dt, *rule) if n_tab < n_ages
+                           else (0.0, _NO_MOMENTS, _NO_MOMENTS))
+    return (decay, w_pre_old, w_pre_new, w_on_old, w_on_new, scale, m_old, m_new,
+            *kernels.age_interval_weights(k, c, dt, n_tab))
+
+
+#: The moments of a run whose tables reach every age (never read, never written).
+_NO_MOMENTS = np.zeros(kernels.BINOM_HALF.size)
 
 
 def _table_ages(n_ages: int) -> int:
@@ -230,19 +245,28 @@ def run_foundation(problem: Problem, dt: float, n_stop: int, snapshot_times=(),
 
 def _ladder_level(problem: Problem, dt: float, n_stop: int, n_preloaded) -> FoundationRun:
     """:func:`run_foundation` of a ladder's level (one kernel call, every row kept, nothing
-    observed) as one compiled call, :func:`pulloff.kernels.onset.run_level`: the same
-    kernels, rows and crossing, without ~40 us of Python per level (a third of a run at rtol
-    1e-6 went to the Python around its five levels)."""
-    n_tab = _table_ages(n_stop + 2)
-    t_rows, gap_rows, step, n_elements, code = kernels.run_level(
-        problem.k, problem.c, problem.h0_scaled, dt, n_stop,
-        _preloaded_count(problem, dt, n_stop, n_preloaded, None), n_tab, n_tab < n_stop + 2,
-        _start_gap(problem))
+    observed): the same kernels, rows and crossing, without the chunks, history and
+    snapshots that cost ~40 us of Python per level (a third of a run at rtol 1e-6 went to the
+    Python around its five levels). Kernels called one by one from here: one compiled call
+    nesting them (and one for the weights) took numba's first compile from 8 to 15 s here,
+    since a caller re-optimises its callees' code."""
+    k, c, h0 = problem.k, problem.c, problem.h0_scaled
+    s0 = problem.s_of(0.0)
+    sig_pre, offset_pre, U_pre, dx_pre = kernels.preloaded_state(
+        s0, _preloaded_count(problem, dt, n_stop, n_preloaded, None), k, c)
+    born, sig_born, U_born, dx_born, no_cubic = _entered_arrays(n_stop + 2, None)
+    sig_born[0] = s0
+    t_rows, gap_rows = np.zeros(n_stop + 1), np.zeros(n_stop + 1)
+    gap_rows[0] = _start_gap(problem)
+    step, n_born, code = kernels.march(
+        sig_pre, offset_pre, U_pre, dx_pre, no_cubic, born, sig_born, U_born, dx_born,
+        no_cubic, 1, 0, 0, n_stop, k, c, h0, dt, *step_weights(k, c, dt, n_stop + 2), t_rows,
+        gap_rows, 0)
     steps = np.arange(step + 1)
     t_detach = (kernels.crossing_time(t_rows[:step + 1], gap_rows[:step + 1])
                 if code == kernels.MARCH_CROSSED else math.nan)
-    return FoundationRun(dt, steps * dt, gap_rows[:step + 1], t_detach, n_elements, step,
-                         steps=steps)
+    return FoundationRun(dt, steps * dt, gap_rows[:step + 1], t_detach,
+                         sig_pre.size + n_born, step, steps=steps)
 
 
 @functools.lru_cache(maxsize=256)
