@@ -141,20 +141,6 @@ def test_age_interval_weights_against_quadrature(k, c, dt):
         assert w_old[m] == pytest.approx(ref_o, rel=1e-9)
 
 
-@settings(max_examples=60, deadline=None)
-@given(k=st.floats(0.0, 1e3), c=st.floats(0.0, 1e2), span=st.floats(1e-6, 1e5),
-       seed=st.integers(0, 2**31))
-def test_property_ratios_at_many_ages_are_the_scalar_ratio_bit_for_bit(k, c, span, seed):
-    """The batched ratio (Chebyshev series summed across a run of ages, vectorised) does the
-    scalar :func:`onset_ratio`'s operations for every age, in every branch."""
-    if k == 0.0 and c == 0.0:
-        return  # no solid
-    ages = np.sort(np.random.default_rng(seed).uniform(0.0, span, 200))
-    out = np.empty(ages.size)
-    K.ratios_at(ages, k, c, out)
-    assert out.tolist() == [K.onset_ratio(a, k, c) for a in ages.tolist()]
-
-
 @pytest.mark.parametrize("mu", [0.6, 3.0, 30.0, 1e3, 1e5, 1e8])
 def test_youngest_interval_weights_resolve_a_layer_of_any_thinness(mu):
     """The octave panels of the youngest interval (relaxation layer ``1/mu`` of a step)

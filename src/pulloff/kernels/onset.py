@@ -369,100 +369,21 @@ def age_interval_weights(k, c, dt, n_ages):
     ratio = np.empty(n_ages + 1)
     w_young = np.empty(n_ages)
     w_old = np.empty(n_ages)
-    n_gl = _GL_X.shape[0]
-    ages = np.empty(n_ages * n_gl)
-    for m in range(n_ages):
-        for i in range(n_gl):
-            ages[m * n_gl + i] = (m + _GL_X[i]) * dt
-    at_nodes = np.empty(ages.shape[0])
-    ratios_at(ages, k, c, at_nodes)
     for m in range(n_ages + 1):
-        ratio[m] = m * dt
-    ratios_at(ratio.copy(), k, c, ratio)
+        ratio[m] = onset_ratio(m * dt, k, c)
     for m in range(n_ages):
         acc_y = 0.0
         acc_o = 0.0
         if m == 0 and k * dt > _SMOOTH_FIRST_INTERVAL * c:
             acc_y, acc_o = _youngest_interval_weights(k, c, dt)
         else:
-            for i in range(n_gl):
-                r = at_nodes[m * n_gl + i]
+            for i in range(_GL_X.shape[0]):
+                r = onset_ratio((m + _GL_X[i]) * dt, k, c)
                 acc_y += _GL_W[i] * r * (1.0 - _GL_X[i])
                 acc_o += _GL_W[i] * r * _GL_X[i]
         w_young[m] = acc_y
         w_old[m] = acc_o
     return ratio, w_young, w_old
-
-
-@njit(cache=True)
-def ratios_at(ages, k, c, out):
-    """:func:`onset_ratio` at every one of ``ages`` (ascending), into ``out``: the same
-    operations per age, but the Chebyshev series of a run of ages in one octave summed
-    together, the coefficient loop outside, so that LLVM vectorises across ages (one
-    Clenshaw recurrence is a chain of dependent operations, ~30 ns; the product weights were
-    ~9 of them per table entry)."""
-    n = ages.shape[0]
-    if c == 0.0 or k == 0.0:
-        for j in range(n):
-            out[j] = onset_ratio(ages[j], k, c)
-        return
-    z = np.empty(n)
-    t = np.empty(n)
-    b1 = np.empty(n)
-    b2 = np.empty(n)
-    for j in range(n):
-        z[j] = k * ages[j] / c
-    j = 0
-    while j < n:
-        octave = _octave(z[j])
-        end = j + 1
-        while end < n and _octave(z[end]) == octave:
-            end += 1
-        if octave < -1 or octave >= RATIO_OCTAVES:
-            for i in range(j, end):
-                out[i] = onset_ratio(ages[i], k, c)
-        else:
-            coefficients = RATIO_NEAR_ZERO if octave == -1 else RATIO_CHEBYSHEV[octave]
-            for i in range(j, end):
-                if octave == -1:
-                    t[i] = 2.0 * z[i] / RATIO_Z_LOW - 1.0
-                else:
-                    mantissa, _ = math.frexp(z[i] / RATIO_Z_LOW)
-                    t[i] = 4.0 * mantissa - 3.0
-                b1[i] = 0.0
-                b2[i] = 0.0
-            _clenshaw_many(coefficients, t, b1, b2, j, end)
-            for i in range(j, end):
-                series = coefficients[0] + t[i] * b1[i] - b2[i]
-                out[i] = ages[i] / c * series if octave == -1 else series / k
-        j = end
-
-
-@njit(cache=True)
-def _octave(z):
-    """Which series :func:`onset_ratio` sums at ``z``: -1 near zero, the octave ``0 ..
-    RATIO_OCTAVES - 1``, or ``RATIO_OCTAVES`` (and beyond) for the asymptotic expansion;
-    -2 for what it treats apart (nan)."""
-    if z < RATIO_Z_LOW:
-        return -1 if z >= 0.0 else -2
-    if z < RATIO_Z_LOW * 2.0 ** RATIO_OCTAVES:
-        return math.frexp(z / RATIO_Z_LOW)[1] - 1
-    return RATIO_OCTAVES if z == z else -2
-
-
-@njit(cache=True)
-def _clenshaw_many(coefficients, t, b1, b2, start, end):
-    """:func:`_clenshaw`'s recurrence (all but its last step) at ``t[start:end]``, in
-    ``b1``, ``b2`` (zeroed)."""
-    # Views and an index from 0: from ``start`` LLVM cannot rule out a negative index's
-    # wraparound and does not vectorise (as in :func:`step_entered`).
-    t_run, b1_run, b2_run = t[start:end], b1[start:end], b2[start:end]
-    for i in range(coefficients.shape[0] - 1, 0, -1):
-        ci = coefficients[i]
-        for j in range(end - start):
-            b_new = ci + 2.0 * t_run[j] * b1_run[j] - b2_run[j]
-            b2_run[j] = b1_run[j]
-            b1_run[j] = b_new
 
 
 @njit(cache=True)
