@@ -221,6 +221,28 @@ def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypa
     assert "INCOMPLETE" in capsys.readouterr().out
 
 
+def test_ctrl_c_in_a_ladder_level_leaves_a_valid_file_marked_incomplete(tmp_path, capsys,
+                                                                      monkeypatch):
+    """A level of the rtol ladder runs as one kernel call (``onset._ladder_level``): a Ctrl-C
+    that arrives in it ends the run as in a long fixed-step one."""
+    from pulloff.kernels import onset as onset_kernels
+
+    real, calls = onset_kernels.march, []
+
+    def interrupt_the_third_level(*args):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(onset_kernels, "march", interrupt_the_third_level)
+    out = tmp_path / "cut.h5"
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot"]) == 130
+    assert "complete = False" in capsys.readouterr().err
+    rec = h5io.load(out)
+    assert rec["complete"] is False and np.all(np.isfinite(rec["history"]["gap"]))
+
+
 def test_cli_run_without_a_plot(tmp_path):
     out = tmp_path / "quiet.h5"
     assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot"]) == 0

@@ -258,10 +258,17 @@ def _ladder_level(problem: Problem, dt: float, n_stop: int, n_preloaded) -> Foun
     sig_born[0] = s0
     t_rows, gap_rows = np.zeros(n_stop + 1), np.zeros(n_stop + 1)
     gap_rows[0] = _start_gap(problem)
-    step, n_born, code = kernels.march(
-        sig_pre, offset_pre, U_pre, dx_pre, no_cubic, born, sig_born, U_born, dx_born,
-        no_cubic, 1, 0, 0, n_stop, k, c, h0, dt, *step_weights(k, c, dt, n_stop + 2), t_rows,
-        gap_rows, 0)
+    try:
+        step, n_born, code = kernels.march(
+            sig_pre, offset_pre, U_pre, dx_pre, no_cubic, born, sig_born, U_born, dx_born,
+            no_cubic, 1, 0, 0, n_stop, k, c, h0, dt, *step_weights(k, c, dt, n_stop + 2),
+            t_rows, gap_rows, 0)
+    except KeyboardInterrupt:
+        # As run_foundation: the rows of the interrupted kernel call are lost, the run ends
+        # at its first row and says so.
+        return FoundationRun(dt, np.zeros(1), gap_rows[:1].copy(), math.nan,
+                             sig_pre.size + 1, 0, interrupted=True,
+                             steps=np.zeros(1, dtype=np.int64))
     steps = np.arange(step + 1)
     t_detach = (kernels.crossing_time(t_rows[:step + 1], gap_rows[:step + 1])
                 if code == kernels.MARCH_CROSSED else math.nan)
