@@ -91,6 +91,9 @@ def kernel_calls(problem: Problem, n: int):
     sig_p, U_p = a["sig_pre"][::2][:half], a["U_pre"][::2][:half]
     off_p = a["offset_pre"][::2][:half]
     t_now = (S - c) / k - problem.h0_scaled  # the time at which s = S
+    # The loads carried from step to step (kernels.onset.cache_loads), at the step's start.
+    q_pre = np.sqrt((a["offset_pre"] + k * (t_now - dt)) * (S - k * dt + sig_pre))
+    r_born = np.sqrt(k * (a["sig_born"][:n] + S - k * dt))
     nodes_p = np.append(sig_p, a["sig_born"][0])
     dx_p = np.append(0.0, [kernels.interval_width(x, y) for x, y in zip(nodes_p[:-1],
                                                                         nodes_p[1:])])
@@ -98,17 +101,16 @@ def kernel_calls(problem: Problem, n: int):
                                                                         a["sig_born"][1:])])
     return {
         "step_preloaded": (lambda: kernels.step_preloaded(
-            sig_pre, a["offset_pre"], U_pre, k * (t_now - dt), k * t_now, S - k * dt, S, decay,
-            w_old, w_new), n),
+            sig_pre, a["offset_pre"], U_pre, q_pre, k * t_now, S, decay, w_old, w_new), n),
         "step_entered": (lambda: kernels.step_entered(
-            sig_born, U_born, 0, n, n - 1, S - k * dt, S, k, decay, w_on_old, w_on_new), n),
+            sig_born, U_born, r_born, 0, n, n - 1, S, k, decay, w_on_old, w_on_new), n),
         "step_entered_aged": (lambda: kernels.step_entered_aged(
-            born[:n], sig_born, U_born, n, n - 1, S - k * dt, S, k, decay, w_on_old[:64],
+            born[:n], sig_born, U_born, r_born, n, n - 1, S, k, decay, w_on_old[:64],
             w_on_new[:64], *moments), n),
         "displacement_integral": (lambda: kernels.displacement_integral(
             sig_p, off_p, U_p, dx_p, no_cubic, born, a["sig_born"], a["U_born"], dx_b,
             no_cubic, n - half, n - half - 1, S, k * t_now, k * dt, ratio, w_young, w_aged,
-            scratch),
+            scratch, np.sqrt((off_p + k * t_now) * (S + sig_p))),
             n),
         "onset_weights": (lambda: kernels.onset_weights(k, c, dt, n, *tables), n),
         "age_interval_weights": (lambda: kernels.age_interval_weights(k, c, dt, n), n),

@@ -165,13 +165,13 @@ def test_entered_element_matches_ode_solution():
     moments = K.onset_moments(k, c, dt, *RULE)
     sig = np.array([sigma])
     U = np.zeros(1)
+    r = np.sqrt(k * (sig + sigma))  # the load's root at the entry, carried from step to step
     for step in range(n):
-        s_old = k * (h0 + step * dt) + c
         s_new = k * (h0 + (step + 1) * dt) + c
         if step % 2:  # both update paths: tables by consecutive age, and by born step
-            K.step_entered(sig, U, 0, 1, step, s_old, s_new, k, decay, w_old, w_new)
+            K.step_entered(sig, U, r, 0, 1, step, s_new, k, decay, w_old, w_new)
         else:
-            K.step_entered_aged(np.zeros(1, dtype=np.int64), sig, U, 1, step, s_old, s_new, k,
+            K.step_entered_aged(np.zeros(1, dtype=np.int64), sig, U, r, 1, step, s_new, k,
                                 decay, w_old, w_new, *moments)
 
     def load(t):
@@ -207,10 +207,11 @@ def test_displacement_integral_exact_for_the_elastic_field(S, k, n, entered_shar
     widths = np.array([0.0] + [K.interval_width(a, b) for a, b in zip(nodes[:-1], nodes[1:])])
     ratio, w_young, w_old = K.age_interval_weights(k, 0.0, 1.0, n_born)
     steps = np.arange(n_born, dtype=np.int64)
+    q_pre = np.sqrt((offset + (S - s0)) * (S + pre))  # the preloaded loads at S
     got = K.displacement_integral(pre, offset, U[:pre.size], widths[:pre.size + 1],
                                   np.zeros((1, 4)), steps, born, U[pre.size:], widths[pre.size:],
                                   np.zeros((1, 4)), n_born, n_born - 1, S, S - s0, k_dt, ratio,
-                                  w_young, w_old, np.empty(nodes.size + 1))
+                                  w_young, w_old, np.empty(nodes.size + 1), q_pre)
     b_minus_1 = S * S / (1.0 + math.sqrt(1.0 + S * S))
     assert got == pytest.approx(b_minus_1 / k, rel=1e-12)
     # Thinned (and with tables shorter than the oldest age), the trapezoid on v = 1/k that
@@ -223,7 +224,7 @@ def test_displacement_integral_exact_for_the_elastic_field(S, k, n, entered_shar
     got = K.displacement_integral(pre, offset, U[:pre.size], widths[:pre.size + 1], pre_w,
                                   steps, sig_e, U_e, dx_e, thin_w, kept, n_born - 1, S, S - s0,
                                   k_dt, ratio[:3], w_young[:2], w_old[:2],
-                                  np.empty(nodes.size + 1))
+                                  np.empty(nodes.size + 1), q_pre)
     assert got == pytest.approx(b_minus_1 / k, rel=1e-12)
 
 
@@ -249,11 +250,12 @@ def test_property_the_vectorised_gap_integral_is_the_general_loop_bit_for_bit(n_
     ratio, w_young, w_old = K.age_interval_weights(k, c, dt, n_born + 2)
     S, kt = sig_born[-1], k * dt * step
     no_cubic = np.zeros((1, 4))
+    q_pre = np.sqrt((offset + kt) * (S + sig_pre))
     fast = K.displacement_integral(sig_pre, offset, U_pre, dx_pre, no_cubic, born, sig_born,
                                    U_born, dx_born, no_cubic, n_born, step, S, kt, k * dt, ratio,
-                                   w_young, w_old, np.empty(n_pre + n_born + 1))
-    loop = (K._preloaded_integral(sig_pre, offset, U_pre, dx_pre, no_cubic, sig_born, U_born,
-                                  n_born, S, kt)
+                                   w_young, w_old, np.empty(n_pre + n_born + 1), q_pre)
+    loop = (K._preloaded_integral(U_pre, q_pre, dx_pre, no_cubic, sig_born, U_born, n_born, S,
+                                  kt)
             + K._entered_integral(born, sig_born, U_born, dx_born, no_cubic, n_born, step, S,
                                   k * dt, ratio, w_young, w_old))
     assert fast == loop

@@ -387,47 +387,65 @@ def age_interval_weights(k, c, dt, n_ages):
 
 
 @njit(cache=True)
-def step_preloaded(sigma, offset, U, kt_old, kt_new, s_old, s_new, decay, w_old, w_new):
+def step_preloaded(sigma, offset, U, q, kt_new, s_new, decay, w_old, w_new):
     """Advance the elements that were inside the zone at ``t = 0`` by one step (in place).
 
     ``offset = s0 - sigma`` (exact, from the mesh) and ``kt = k t``: ``s - sigma`` is formed as
-    their sum, never as a difference of two nearly equal ``s`` and ``sigma``.
+    their sum, never as a difference of two nearly equal ``s`` and ``sigma``. ``q`` holds each
+    element's load at the start of the step and receives the one at its end (the next step's
+    start, and what the gap integral divides by: one square root per element and step, not
+    three; see :func:`cache_loads`).
     """
     for i in range(sigma.shape[0]):
-        sg = sigma[i]
-        q_old = math.sqrt((offset[i] + kt_old) * (s_old + sg))
-        q_new = math.sqrt((offset[i] + kt_new) * (s_new + sg))
-        U[i] = decay * U[i] + w_old * q_old + w_new * q_new
+        q_new = math.sqrt((offset[i] + kt_new) * (s_new + sigma[i]))
+        U[i] = decay * U[i] + w_old * q[i] + w_new * q_new
+        q[i] = q_new
 
 
 @njit(cache=True)
-def step_entered(sigma, U, j_first, n_born, age_base, s_old, s_new, k, decay, w_old, w_new):
+def step_entered(sigma, U, r, j_first, n_born, age_base, s_new, k, decay, w_old, w_new):
     """Advance entered elements ``j_first .. n_born - 1``, born on consecutive steps, by one
-    step (in place): element ``j`` is ``age_base - j`` steps old, within the tables. This loop
-    is all there is in a run without a budget; kept free of branches, it vectorises."""
+    step (in place): element ``j`` is ``age_base - j`` steps old, within the tables. ``r``:
+    ``sqrt(k (sigma + s))`` at the start of the step in, at its end out (see
+    :func:`cache_loads`). This loop is all there is in a run without a budget; kept free of
+    branches, it vectorises."""
     # Views from j_first and an index from 0: written as a loop over j from j_first, LLVM
     # does not vectorise it (measured 5 ns against 1.2 ns per element).
     sig_tail = sigma[j_first:n_born]
     U_tail = U[j_first:n_born]
+    r_tail = r[j_first:n_born]
     top = age_base - j_first
     for i in range(n_born - j_first):
         age = top - i
-        sg = sig_tail[i]
-        r_old = math.sqrt(k * (sg + s_old))
-        r_new = math.sqrt(k * (sg + s_new))
-        U_tail[i] = decay * U_tail[i] + w_old[age] * r_old + w_new[age] * r_new
+        r_new = math.sqrt(k * (sig_tail[i] + s_new))
+        U_tail[i] = decay * U_tail[i] + w_old[age] * r_tail[i] + w_new[age] * r_new
+        r_tail[i] = r_new
 
 
 @njit(cache=True)
-def step_entered_aged(born, sigma, U, j_stop, step, s_old, s_new, k, decay, w_old, w_new, scale,
+def step_entered_aged(born, sigma, U, r, j_stop, step, s_new, k, decay, w_old, w_new, scale,
                       m_old, m_new):
     """Advance entered elements ``0 .. j_stop - 1`` by one step (in place): those left apart
     by thinning or older than the tables. Element ``j`` entered at step ``born[j]``; ages
-    beyond the tables use :func:`onset_weight_pair`'s expansion."""
+    beyond the tables use :func:`onset_weight_pair`'s expansion. ``r`` as in
+    :func:`step_entered`."""
     for j in range(j_stop):
-        sg = sigma[j]
         wo, wn = onset_weight_pair(step - born[j], w_old, w_new, scale, m_old, m_new)
-        U[j] = decay * U[j] + wo * math.sqrt(k * (sg + s_old)) + wn * math.sqrt(k * (sg + s_new))
+        r_new = math.sqrt(k * (sigma[j] + s_new))
+        U[j] = decay * U[j] + wo * r[j] + wn * r_new
+        r[j] = r_new
+
+
+@njit(cache=True)
+def cache_loads(sig_pre, offset_pre, q, sig_born, r, n_born, k, kt, s):
+    """The loads at ``s`` (``kt = k t``) that the step kernels carry from one step to the
+    next: ``q`` of the preloaded elements, ``r = sqrt(k (sigma + s))`` of the entered ones,
+    by the very expressions those kernels use, so that a run is the same to the bit whether
+    a step recomputes its start's load or takes it from the step before."""
+    for i in range(sig_pre.shape[0]):
+        q[i] = math.sqrt((offset_pre[i] + kt) * (s + sig_pre[i]))
+    for j in range(n_born):
+        r[j] = math.sqrt(k * (sig_born[j] + s))
 
 
 @njit(cache=True)
@@ -504,7 +522,7 @@ def preloaded_cubic_weights(dx_pre):
 @njit(cache=True)
 def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born,
                           dx_born, thin_w, n_born, step, S, kt, k_dt, ratio, w_young, w_old,
-                          scratch):
+                          scratch, q_pre):
     """``int_1^b U(x) / sqrt(b^2 - x^2) dx`` over the free zone (units of ``delta``).
 
     The field is written ``U = sqrt(b^2 - x^2) v(x)``, so no quadrature node sits on the
@@ -526,26 +544,23 @@ def displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_b
     if (pre_w.shape[0] != sig_pre.shape[0] + 1 and n_born > 1 and born[n_born - 1] == step
             and step - born[0] == n_born - 1 and step - born[0] < w_young.shape[0]):
         # (a ladder's level: no budget, every element consecutive and within the tables)
-        return (_preloaded_trapezoid(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, S,
-                                     kt, scratch)
+        return (_preloaded_trapezoid(U_pre, q_pre, dx_pre, sig_born, U_born, S, kt, scratch)
                 + _entered_consecutive(born, sig_born, U_born, dx_born, n_born, step, S, k_dt,
                                        ratio, w_young, w_old, scratch))
-    return (_preloaded_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, sig_born, U_born,
-                                n_born, S, kt)
+    return (_preloaded_integral(U_pre, q_pre, dx_pre, pre_w, sig_born, U_born, n_born, S, kt)
             + _entered_integral(born, sig_born, U_born, dx_born, thin_w, n_born, step, S, k_dt,
                                 ratio, w_young, w_old))
 
 
 @njit(cache=True, error_model="numpy")
-def _preloaded_trapezoid(sig_pre, offset_pre, U_pre, dx_pre, sig_born, U_born, S, kt,
-                         scratch):
+def _preloaded_trapezoid(U_pre, q_pre, dx_pre, sig_born, U_born, S, kt, scratch):
     """:func:`_preloaded_integral` with the trapezoid on ``v`` and an entered element beyond
     the oldest (the same operations in the same order): ``v`` first in a loop without
     dependences, which LLVM vectorises (numpy's error model: no division check), then the
     sum."""
-    n_pre = sig_pre.shape[0]
+    n_pre = U_pre.shape[0]
     for i in range(n_pre):
-        scratch[i] = U_pre[i] / math.sqrt((offset_pre[i] + kt) * (S + sig_pre[i]))
+        scratch[i] = U_pre[i] / q_pre[i]
     scratch[n_pre] = U_born[0] / math.sqrt(kt * (S + sig_born[0]))
     total = 0.0
     for i in range(1, n_pre + 1):
@@ -573,29 +588,22 @@ def _entered_consecutive(born, sig_born, U_born, dx_born, n_born, step, S, k_dt,
 
 
 @njit(cache=True)
-def _preloaded_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, sig_born, U_born, n_born,
-                        S, kt):
-    """The part of :func:`displacement_integral` over the elements loaded since ``t = 0`` and
-    the oldest entered one."""
+def _preloaded_integral(U_pre, q_pre, dx_pre, pre_w, sig_born, U_born, n_born, S, kt):
+    """The part of :func:`displacement_integral` over the elements loaded since ``t = 0``
+    (their loads ``q_pre`` at ``S``) and the oldest entered one."""
     total = 0.0
-    n_pre = sig_pre.shape[0]
+    n_pre = U_pre.shape[0]
     cubic = pre_w.shape[0] == n_pre + 1
     v_prev = 0.0
     p1 = p2 = 0.0  # v at i - 3, i - 2 (v_prev is v at i - 1)
     for i in range(n_pre + 1):
         if i < n_pre:
-            sg = sig_pre[i]
-            u = U_pre[i]
-            ahead = offset_pre[i] + kt
-        else:
-            sg = sig_born[0]
-            u = U_born[0]
-            ahead = kt
-        if i == n_pre and n_born == 1:
+            v = U_pre[i] / q_pre[i]
+        elif n_born == 1:
             # The element at s0 is at b: k == 0 (b fixed, U/q the same everywhere) or t = 0.
             v = v_prev
         else:
-            v = u / math.sqrt(ahead * (S + sg))
+            v = U_born[0] / math.sqrt(kt * (S + sig_born[0]))
         if cubic:
             if i >= 2:
                 w = pre_w[i - 1]
@@ -764,34 +772,38 @@ def march(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_
     capacity = sig_born.shape[0]
     n_tab = w_on_old.shape[0]
     scratch = np.empty(max(sig_pre.shape[0] + 1, capacity))
+    q_pre = np.empty(sig_pre.shape[0])
+    r_born = np.empty(capacity)
+    cache_loads(sig_pre, offset_pre, q_pre, sig_born, r_born, n_born, k, k * (step * dt),
+                k * (h0 + step * dt) + c)
     while step < step_stop:
         if k > 0.0 and n_born >= capacity:
             return step, n_born, MARCH_FULL
-        t_old = step * dt
         t_new = (step + 1) * dt
-        s_old = k * (h0 + t_old) + c
         s_new = k * (h0 + t_new) + c
-        step_preloaded(sig_pre, offset_pre, U_pre, k * t_old, k * t_new, s_old, s_new, decay,
-                       w_pre_old, w_pre_new)
+        step_preloaded(sig_pre, offset_pre, U_pre, q_pre, k * t_new, s_new, decay, w_pre_old,
+                       w_pre_new)
         # Ages fall with j: thinned elements and those older than the tables come first.
         j_split = j_consecutive
         while j_split < n_born and step - born[j_split] >= n_tab:
             j_split += 1
-        step_entered_aged(born, sig_born, U_born, j_split, step, s_old, s_new, k, decay,
+        step_entered_aged(born, sig_born, U_born, r_born, j_split, step, s_new, k, decay,
                           w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new)
         if j_split < n_born:
-            step_entered(sig_born, U_born, j_split, n_born, step - born[j_split] + j_split,
-                         s_old, s_new, k, decay, w_on_old, w_on_new)
+            step_entered(sig_born, U_born, r_born, j_split, n_born,
+                         step - born[j_split] + j_split, s_new, k, decay, w_on_old, w_on_new)
         step += 1
         if k > 0.0:
             born[n_born] = step
             sig_born[n_born] = s_new
             U_born[n_born] = 0.0
+            r_born[n_born] = math.sqrt(k * (s_new + s_new))  # its load at the next start
             dx_born[n_born] = interval_width(sig_born[n_born - 1], s_new)
             n_born += 1
         integral = displacement_integral(sig_pre, offset_pre, U_pre, dx_pre, pre_w, born,
                                          sig_born, U_born, dx_born, thin_w, n_born, step, s_new,
-                                         k * t_new, k * dt, ratio, w_young, w_old, scratch)
+                                         k * t_new, k * dt, ratio, w_young, w_old, scratch,
+                                         q_pre)
         g = gap_from_integral(h0 + t_new, s_new, integral)
         t_out[step - row0] = t_new
         gap_out[step - row0] = g
