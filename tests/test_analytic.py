@@ -603,3 +603,14 @@ def test_property_the_groups_of_python_floats_are_their_array_form_bit_for_bit(v
             assert type(scalar) is float
             assert (scalar == array and math.copysign(1.0, scalar) == math.copysign(1.0, array)
                     or math.isnan(scalar) and math.isnan(array)), (form.__name__, args)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.floats(0.0, 3.0), min_size=0, max_size=40))
+def test_property_the_cohesive_force_of_an_array_is_each_of_its_rows_alone(S):
+    """Each row of a history's cohesive force is the scalar path's value, bit for bit, whatever
+    the other rows (an empty history gives an empty column)."""
+    b = np.sqrt(1.0 + np.asarray(S, dtype=float) ** 2)
+    rows = A.cohesive_force(2.0, 1.0, b)
+    assert rows.shape == b.shape
+    assert rows.tolist() == [A.cohesive_force(2.0, 1.0, float(x)) for x in b.tolist()]

@@ -480,3 +480,9 @@ def test_property_the_rows_quadratic_has_numpys_first_positive_root(c):
     assert bool(ours) == bool(theirs), (ours, theirs)
     if ours:
         assert min(ours) == pytest.approx(min(theirs), rel=1e-9), (ours, theirs)
+
+
+def test_a_relaxation_layer_below_the_smallest_float_is_the_elastic_limit():
+    """c / (k dt) underflowing to zero (or dt overflowing) ends at once with R = 1/k."""
+    assert K._youngest_interval_weights(1.0, 5e-324, 10.0) == (0.5, 0.5)
+    assert K._youngest_interval_weights(1e200, 1e-200, 1e100) == (0.5e-200, 0.5e-200)

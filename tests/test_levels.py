@@ -228,3 +228,10 @@ def test_property_richardson_over_floats_is_its_array_form_bit_for_bit(k, data, 
     got = levels.richardson(values, order, floor)
     want = _richardson_as_arrays(values, order, floor)
     assert [repr(x) for x in got] == [repr(x) for x in want]
+
+
+def test_outputs_given_as_lists_of_other_numbers_are_floats():
+    from pulloff.solvers import levels as L
+
+    assert L._floats([1, 2]) == [1.0, 2.0] and all(type(x) is float for x in L._floats([1, 2]))
+    assert math.isnan(L._floats([None, 1.0])[0])

@@ -332,3 +332,13 @@ def test_readme_lists_every_output_from_the_table():
     text = (ROOT / "README.md").read_text()
     block = text.split("<!-- outputs:begin -->\n", 1)[1].split("\n<!-- outputs:end -->", 1)[0]
     assert block == outputs.markdown()
+
+
+def test_yaml_copies_are_deep_and_survive_aliases_that_contain_themselves():
+    from pulloff.io.scene_file import read_yaml
+
+    first = read_yaml("a: {b: [1, 2]}")
+    first["a"]["b"].append(3)
+    assert read_yaml("a: {b: [1, 2]}") == {"a": {"b": [1, 2]}}  # the cache was not touched
+    looped = read_yaml("a: &x [1, *x]")
+    assert looped["a"][0] == 1 and looped["a"][1] is looped["a"]

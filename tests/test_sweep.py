@@ -84,10 +84,11 @@ def test_parallel_batches_give_every_row_once_as_one_process_does(seed, monkeypa
     assert np.all(parallel["status"] == "ok")
 
 
-def test_batch_size_follows_the_run_times_of_a_finished_batch():
+def test_batch_size_follows_the_slowest_scene_of_a_finished_batch_and_grows_gently():
     ok = [(0, {"wall_time": 0.002}), (1, {"wall_time": 0.003})]
-    assert sw._batch_size(ok, 1) == int(sw.BATCH_SECONDS * 2 / (0.002 + 0.003))
-    assert sw._batch_size([(0, {"wall_time": 1e-9})], 1) == sw.MAX_BATCH
+    assert sw._batch_size(ok, 1) == 2  # at most twice the last batch
+    assert sw._batch_size(ok, 16) == int(sw.BATCH_SECONDS / 0.003)  # by the slowest scene
+    assert sw._batch_size([(0, {"wall_time": 1e-9})], 40) == sw.MAX_BATCH
     assert sw._batch_size([(0, {"wall_time": 10.0})], 7) == 1
     assert sw._batch_size([(0, {"status": "failed"})], 7) == 7  # nothing timed: unchanged
 

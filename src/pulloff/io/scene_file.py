@@ -87,7 +87,11 @@ def read_yaml(text: str, where: str = "scene"):
     The same text is parsed once per process (a sweep reads its base scene and each axis
     value for every point, and parsing was half of a sweep's time); each call gets its own
     copy."""
-    return plain_copy(_parsed_yaml(text, where))
+    data = _parsed_yaml(text, where)
+    try:
+        return plain_copy(data)
+    except RecursionError:  # aliases that contain themselves: deepcopy keeps the cycle
+        return copy.deepcopy(data)
 
 
 def plain_copy(data):

@@ -343,6 +343,8 @@ def _youngest_interval_weights(k, c, dt):
     acc_y = acc_o = 0.0
     low = 0.0
     high = min(1.0, c / (k * dt))
+    if not high > 0.0:
+        return 0.5 / k, 0.5 / k  # a layer below the smallest float: R = 1/k at every z > 0
     while low < 1.0:
         width = high - low
         for i in range(_GL12_X.shape[0]):

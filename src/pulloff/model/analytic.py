@@ -24,8 +24,6 @@ therefore not an identity, but eq. 74 and everything derived from it (eqs. 75-83
 
 from __future__ import annotations
 
-import bisect
-import itertools
 import json
 import math
 from fractions import Fraction
@@ -626,26 +624,10 @@ def _cohesive_bracket(S):
 
 
 def _cohesive_series(S):
+    """The series below ``S = 0.5``, all its terms (as :func:`_cohesive_force_scalar`, bit
+    for bit; a truncation chosen per array made an element depend on its neighbours)."""
     s2 = S * S
-    return S * s2 * _horner(_COH_SERIES[:_series_terms(float(s2.max()))], s2)
-
-
-def _series_terms(s2_max: float) -> int:
-    """Terms of ``_COH_SERIES`` whose sum is exact to rounding for ``S^2 <= s2_max``: the
-    first omitted one is below 2^-56 of the leading ``2/3`` (all 30 at ``S = 0.5``; 5 for the
-    thin zones of a run's history, where 30 over every row were most of its SI columns, and
-    whose powers would otherwise reach subnormal numbers)."""
-    return min(len(_COH_SERIES), bisect.bisect_left(_COH_SERIES_REACH, s2_max) + 1)
-
-
-def _series_reach():
-    """``S^2`` up to which the first ``n + 1`` terms of ``_COH_SERIES`` suffice (ascending)."""
-    reach = [(2.0 ** -56 * _COH_SERIES[0] / abs(c)) ** (1.0 / n)
-             for n, c in enumerate(_COH_SERIES) if n > 0]
-    return list(itertools.accumulate(reach, max))
-
-
-_COH_SERIES_REACH = _series_reach()
+    return S * s2 * _horner(_COH_SERIES, s2)
 
 
 def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
@@ -655,7 +637,7 @@ def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
     S = math.sqrt((b - a) * (b + a)) / a
     if S < _COH_SERIES_MAX_S:
         s2 = S * S
-        bracket = S * s2 * _horner_scalar(_COH_SERIES[:_series_terms(s2)], s2)
+        bracket = S * s2 * _horner_scalar(_COH_SERIES, s2)
     else:
         bracket = (1.0 + S * S) * math.atan(S) - S
     return 2.0 * sigma_c * a * a * bracket

@@ -40,7 +40,9 @@ def _floats(v) -> list:
     arithmetic on them runs after every level of every run: float operations are the same
     IEEE ones as numpy's, without ~1 us per array call (a fifth of a ~1 ms onset run went to
     the ladder's array calls)."""
-    return v if type(v) is list else np.asarray(v, dtype=float).tolist()
+    if type(v) is list and all(type(x) is float for x in v):
+        return v
+    return np.asarray(v, dtype=float).tolist()
 
 
 def _scale_floats(v: list, floor) -> list:

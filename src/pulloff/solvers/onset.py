@@ -94,7 +94,7 @@ def step_weights(k: float, c: float, dt: float, n_ages: int):
     steps (tables of zeros when ``k = 0``: no element ever enters)."""
     n_tab = _table_ages(n_ages)
     decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
-    if k == 0.0:
+    if not k > 0.0:
         zeros = np.zeros(n_tab)
         return (decay, w_pre_old, w_pre_new, zeros, zeros, 0.0, _NO_MOMENTS, _NO_MOMENTS,
                 np.zeros(n_tab + 1), zeros, zeros)
