@@ -94,6 +94,7 @@ def kernel_calls(problem: Problem, n: int):
     # The loads carried from step to step (kernels.onset.cache_loads), at the step's start.
     q_pre = np.sqrt((a["offset_pre"] + k * (t_now - dt)) * (S - k * dt + sig_pre))
     r_born = np.sqrt(k * (a["sig_born"][:n] + S - k * dt))
+    q_p = np.sqrt((off_p + k * t_now) * (S + sig_p))  # the carried loads at S
     nodes_p = np.append(sig_p, a["sig_born"][0])
     dx_p = np.append(0.0, [kernels.interval_width(x, y) for x, y in zip(nodes_p[:-1],
                                                                         nodes_p[1:])])
@@ -110,7 +111,7 @@ def kernel_calls(problem: Problem, n: int):
         "displacement_integral": (lambda: kernels.displacement_integral(
             sig_p, off_p, U_p, dx_p, no_cubic, born, a["sig_born"], a["U_born"], dx_b,
             no_cubic, n - half, n - half - 1, S, k * t_now, k * dt, ratio, w_young, w_aged,
-            scratch, np.sqrt((off_p + k * t_now) * (S + sig_p))),
+            scratch, q_p),
             n),
         "onset_weights": (lambda: kernels.onset_weights(k, c, dt, n, *tables), n),
         "age_interval_weights": (lambda: kernels.age_interval_weights(k, c, dt, n), n),
