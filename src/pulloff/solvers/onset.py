@@ -92,7 +92,9 @@ def step_weights(k: float, c: float, dt: float, n_ages: int):
     ``(decay, w_pre_old, w_pre_new, w_on_old, w_on_new, onset_scale, onset_m_old, onset_m_new,
     ratio, w_young, w_old)``, tabulated for element ages up to ``min(n_ages, _TABLE_AGES)``
     steps (tables of zeros when ``k = 0``: no element ever enters)."""
-    n_tab = _table_ages(n_ages)
+    # A run shorter than the expansion's first age never needs it: its tables cover every age.
+    n_tab = (n_ages if n_ages <= kernels.ONSET_ASYMPTOTIC_AGE
+             else max(kernels.ONSET_ASYMPTOTIC_AGE, min(n_ages, _TABLE_AGES)))
     decay, w_pre_old, w_pre_new = kernels.linear_load_weights(k, c, dt)
     if not k > 0.0:
         zeros = np.zeros(n_tab)
@@ -109,13 +111,6 @@ def step_weights(k: float, c: float, dt: float, n_ages: int):
 
 #: The moments of a run whose tables reach every age (never read, never written).
 _NO_MOMENTS = np.zeros(kernels.BINOM_HALF.size)
-
-
-def _table_ages(n_ages: int) -> int:
-    """Ages tabulated for a run whose elements reach ``n_ages`` steps: all of them, up to
-    ``_TABLE_AGES`` (a run shorter than the expansion's first age never needs it)."""
-    return (n_ages if n_ages <= kernels.ONSET_ASYMPTOTIC_AGE
-            else max(kernels.ONSET_ASYMPTOTIC_AGE, min(n_ages, _TABLE_AGES)))
 
 
 class _History:
@@ -251,17 +246,16 @@ def _ladder_level(problem: Problem, dt: float, n_stop: int, n_preloaded) -> Foun
     nesting them (and one for the weights) took numba's first compile from 8 to 15 s here,
     since a caller re-optimises its callees' code."""
     k, c, h0 = problem.k, problem.c, problem.h0_scaled
-    s0 = problem.s_of(0.0)
-    sig_pre, offset_pre, U_pre, dx_pre = kernels.preloaded_state(
-        s0, _preloaded_count(problem, dt, n_stop, n_preloaded, None), k, c)
-    born, sig_born, U_born, dx_born, no_cubic = _entered_arrays(n_stop + 2, None)
-    sig_born[0] = s0
+    sig_pre, offset_pre, U_pre, dx_pre, pre_w = _preloaded(problem, dt, n_stop, n_preloaded,
+                                                           None)
+    born, sig_born, U_born, dx_born, thin_w = _entered_arrays(n_stop + 2, None)
+    sig_born[0] = problem.s_of(0.0)
     t_rows, gap_rows = np.zeros(n_stop + 1), np.zeros(n_stop + 1)
     gap_rows[0] = _start_gap(problem)
     try:
         step, n_born, code = kernels.march(
-            sig_pre, offset_pre, U_pre, dx_pre, no_cubic, born, sig_born, U_born, dx_born,
-            no_cubic, 1, 0, 0, n_stop, k, c, h0, dt, *step_weights(k, c, dt, n_stop + 2),
+            sig_pre, offset_pre, U_pre, dx_pre, pre_w, born, sig_born, U_born, dx_born,
+            thin_w, 1, 0, 0, n_stop, k, c, h0, dt, *step_weights(k, c, dt, n_stop + 2),
             t_rows, gap_rows, 0)
     except KeyboardInterrupt:
         # As run_foundation: the rows of the interrupted kernel call are lost, the run ends
@@ -314,7 +308,10 @@ def _preloaded(problem: Problem, dt: float, n_stop: int, n_preloaded, max_elemen
     bounds them to a quarter of it: the mesh then stops refining with the step)."""
     k, c = problem.k, problem.c
     s0 = problem.s_of(0.0)
-    n_pre = _preloaded_count(problem, dt, n_stop, n_preloaded, max_elements)
+    s_ref = problem.s_of(n_stop * dt)
+    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * s0 / s_ref)))
+    if max_elements is not None:
+        n_pre = min(n_pre, max(8, int(max_elements) // 4))
     # An elastic element follows its load at once, also the step lift h0 at t = 0; a damper
     # cannot move instantly (MODEL.md: u(x,0) = 0).
     sig_pre, offset_pre, U_pre, dx_pre = kernels.preloaded_state(float(s0), n_pre, k, c)
@@ -323,16 +320,6 @@ def _preloaded(problem: Problem, dt: float, n_stop: int, n_preloaded, max_elemen
     pre_w = (kernels.preloaded_cubic_weights(dx_pre) if max_elements is not None
              and sig_pre.size >= 3 else np.zeros((1, 4)))
     return sig_pre, offset_pre, U_pre, dx_pre, pre_w
-
-
-def _preloaded_count(problem: Problem, dt: float, n_stop: int, n_preloaded,
-                     max_elements) -> int:
-    """Elements in the zone loaded at ``t = 0`` (see :func:`_preloaded`)."""
-    n_pre = n_preloaded or max(8, int(math.ceil(n_stop * problem.s_of(0.0)
-                                                / problem.s_of(n_stop * dt))))
-    if max_elements is not None:
-        n_pre = min(n_pre, max(8, int(max_elements) // 4))
-    return n_pre
 
 
 def _snapshots(problem: Problem, wanted: dict, captured: dict, dt: float, t_end: float):
