@@ -235,3 +235,31 @@ def test_outputs_given_as_lists_of_other_numbers_are_floats():
 
     assert L._floats([1, 2]) == [1.0, 2.0] and all(type(x) is float for x in L._floats([1, 2]))
     assert math.isnan(L._floats([None, 1.0])[0])
+
+
+@settings(max_examples=200, deadline=None)
+@given(k=st.integers(1, 5), data=st.data(), with_floor=st.booleans(),
+       method=st.sampled_from(["method", "measured"]))
+def test_property_extrapolation_given_the_ladders_richardson_is_the_same_bit_for_bit(
+        k, data, with_floor, method):
+    """The ladder hands its own Richardson result to the extrapolation (once it computed it
+    twice per level): the outputs and estimate are those the extrapolation computes alone."""
+    n_levels = 4 if method == "method" else 3
+    values = [levels._floats(data.draw(st.lists(_OUTPUT, min_size=k, max_size=k)))
+              for _ in range(n_levels)]
+    floor = (np.array(data.draw(st.lists(st.floats(0.0, 10.0), min_size=k, max_size=k)))
+             if with_floor else None)
+    order = levels.Order(1.0, 2.0)
+    extrapolation = levels._EXTRAPOLATIONS[method]
+    raw = levels.richardson(values[-3:], order, floor)
+    got_values, got_estimate = extrapolation(values, order, floor, raw=raw)
+    want_values, want_estimate = extrapolation(values, order, floor)
+    assert repr(got_estimate) == repr(want_estimate)
+    assert [repr(x) for x in np.asarray(got_values).tolist()] == \
+        [repr(x) for x in np.asarray(want_values).tolist()]
+
+
+def test_outputs_already_converted_are_not_converted_again():
+    once = levels._floats(np.array([1.0, math.nan]))
+    assert levels._floats(once) is once and type(once[0]) is float
+    assert type(levels._floats([1.0, 2.0])) is levels._Floats

@@ -35,14 +35,20 @@ def _scale(v: np.ndarray, floor) -> np.ndarray:
     return np.maximum(np.abs(v), 0.0 if floor is None else np.asarray(floor, dtype=float))
 
 
+class _Floats(list):
+    """A list known to hold Python floats only (what :func:`_floats` returns): the ladder
+    converts each level's outputs once, and its every later look at them costs one type
+    check instead of one per element."""
+
+
 def _floats(v) -> list:
     """An output vector as Python floats. A level has a handful of outputs, and the ladder's
     arithmetic on them runs after every level of every run: float operations are the same
     IEEE ones as numpy's, without ~1 us per array call (a fifth of a ~1 ms onset run went to
     the ladder's array calls)."""
-    if type(v) is list and all(type(x) is float for x in v):
+    if type(v) is _Floats:
         return v
-    return np.asarray(v, dtype=float).tolist()
+    return _Floats(np.asarray(v, dtype=float).tolist())
 
 
 def _scale_floats(v: list, floor) -> list:
@@ -65,6 +71,7 @@ def relative_spread(a: np.ndarray, b: np.ndarray, floor=None) -> float:
     run found an event the other did not)."""
     if not same_events([a, b]):
         return math.inf
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     scale = _scale(b, floor)
     mask = np.isfinite(a) & np.isfinite(b) & (scale != 0)
     if not np.any(mask):
@@ -109,8 +116,8 @@ def richardson(values: Sequence[np.ndarray], order: Order, floor=None) -> tuple[
     return float(worst_last / (2.0 ** p - 1.0)), measured
 
 
-def extrapolate(values: Sequence[np.ndarray], order: Order,
-                floor=None) -> tuple[np.ndarray, float]:
+def extrapolate(values: Sequence[np.ndarray], order: Order, floor=None,
+                raw: tuple[float, float] | None = None) -> tuple[np.ndarray, float]:
     """Richardson-extrapolated outputs of the finest of three or four levels, and an estimate
     of their relative error.
 
@@ -137,13 +144,14 @@ def extrapolate(values: Sequence[np.ndarray], order: Order,
 
     Below the diverging order of the levels themselves no extrapolation is made: the finest
     values, with :func:`richardson`'s estimate (the larger of the last two changes; rounding
-    alone on a scene the levels solve exactly).
+    alone on a scene the levels solve exactly). ``raw`` is :func:`richardson`'s result on the
+    last three levels where the caller has it already.
     """
     v = [_floats(x) for x in values[-4:]]
     if not same_events(v):
         # An event (detachment) found on some levels only: not converged.
         return np.array(v[-1]), math.inf
-    raw_estimate, measured = richardson(v[-3:], order, floor)
+    raw_estimate, measured = raw or richardson(v[-3:], order, floor)
     if not math.isfinite(measured) or measured < DIVERGING_ORDER:
         # Outputs unchanged, levels not converging, or (an exact scene) differing by rounding
         # alone: the finest level, with the larger of its last two changes as the estimate.
@@ -168,8 +176,8 @@ def extrapolate(values: Sequence[np.ndarray], order: Order,
     return finest, float(max(d_last, d_prev / 2.0 ** q) / (2.0 ** q - 1.0))
 
 
-def extrapolate_measured(values: Sequence[np.ndarray], order: Order,
-                         floor=None) -> tuple[np.ndarray, float]:
+def extrapolate_measured(values: Sequence[np.ndarray], order: Order, floor=None,
+                         raw: tuple[float, float] | None = None) -> tuple[np.ndarray, float]:
     """The contact solver's extrapolation: the finest of three levels extrapolated with the
     order :func:`richardson` measures (clipped to ``order``). Its estimate, per output, is
     the larger of the change between the extrapolations from the last two pairs of levels
@@ -184,10 +192,10 @@ def extrapolate_measured(values: Sequence[np.ndarray], order: Order,
     estimate is 1.6-34x the error against the moving-edge reference on its scenes at rtol 1e-3
     to 1e-6 (``benchmarks/contact_estimate.py``); 0.92x on ``separation_kv`` at 1e-2 m/s and
     rtol 1e-6, whose levels converge at a falling order (25x below before the gap integral
-    stopped crossing the punch's first bond edge).
+    stopped crossing the punch's first bond edge). ``raw`` as for :func:`extrapolate`.
     """
     v0, v1, v2 = (np.asarray(v, dtype=float) for v in values[-3:])
-    raw_estimate, measured = richardson(values[-3:], order, floor)
+    raw_estimate, measured = raw or richardson(values[-3:], order, floor)
     if not math.isfinite(measured) or measured < DIVERGING_ORDER:
         # Events found on some levels only (richardson's estimate is then inf), outputs
         # unchanged, or levels not (yet) converging regularly: the finest level, with
@@ -269,13 +277,14 @@ def refine(run: Callable[[int], object], outputs: Callable[[object], np.ndarray]
         levels.append(run(n))
         if interrupted(levels[-1]):
             return Ladder(levels, math.nan, math.nan)
-        outs.append(outputs(levels[-1]))
+        outs.append(_floats(outputs(levels[-1])))
         if len(levels) >= 3:
             last = outs[-4 if extrapolated else -3:]
             lowest = None if floor is None else floor(levels[-1])
             estimate, measured = richardson(last[-3:], order, lowest)
             if extrapolated:
-                values, estimate = _EXTRAPOLATIONS[extrapolated](last, order, lowest)
+                values, estimate = _EXTRAPOLATIONS[extrapolated](last, order, lowest,
+                                                                 raw=(estimate, measured))
             regular = len(levels) > 3 or not measured > first_order_max
             if (estimate <= 0.5 * rtol and len(levels) >= _MIN_LEVELS[extrapolated]
                     and regular):
