@@ -122,10 +122,11 @@ _S_EXACT, _S_INTERP, _S_FROZEN = 0, 1, 2  # how s(t) = q_r/(2 sigma_c) is known
 
 
 # --------------------------------------------------------------------------------------------
-# numba kernels (all private to this file, cache=False)
+# numba kernels (all private to this file, which also keeps them safe in the disk cache:
+# none calls a compiled function of another module)
 # --------------------------------------------------------------------------------------------
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _sq_exact(t, sp):
     """s(t) = q_r(t)/(2 sigma_c) of the bonded track under a rigid machine (h = h0 + v t)."""
     kind = int(sp[0])
@@ -149,7 +150,7 @@ def _sq_exact(t, sp):
     return 2.0 * s / sig
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _poly(c, p):
     acc = 0.0
     for j in range(c.size - 1, -1, -1):
@@ -157,7 +158,7 @@ def _poly(c, p):
     return acc
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _dpoly(c, p):
     acc = 0.0
     for j in range(c.size - 1, 0, -1):
@@ -165,7 +166,7 @@ def _dpoly(c, p):
     return acc
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _eval(k, p, ymode, smode, tco, yco, sco, sp):
     """(t, dt/dp, A - R^2, B - R^2, s) on step k at parameter p (p may leave [0, 1])."""
     c = tco[k]
@@ -194,7 +195,7 @@ def _eval(k, p, ymode, smode, tco, yco, sco, sp):
     return t, tp, dA, dB, sq
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _prep(k0, k1, T, ymode, smode, tco, yco, sco, sp, lam, sigma, gx, gw,
           dBg, Kg, Ok, dBx, stiff):
     """Fast-path data of steps k0..k1-1: Gauss nodes, kernel weights, outside-zone integral."""
@@ -221,7 +222,7 @@ def _prep(k0, k1, T, ymode, smode, tco, yco, sco, sp, lam, sigma, gx, gw,
         stiff[k] = st
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _gk15_seg(k, X2, r0, r1, pstar, sgn, T1, ymode, smode, tco, yco, sco, sp, lam, sigma,
               xk, wk, wg, resk, resg):
     """Kronrod-15 and Gauss-7 of the per-mode step integrand over r in [r0, r1].
@@ -266,7 +267,7 @@ def _gk15_seg(k, X2, r0, r1, pstar, sgn, T1, ymode, smode, tco, yco, sco, sp, la
                 resg[m] += wgg * f * hl
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _adapt_step(k, X2, r0, r1, pstar, sgn, T1, ymode, smode, tco, yco, sco, sp, lam, sigma,
                 tol, out, xk, wk, wg):
     M = lam.size
@@ -304,7 +305,7 @@ def _adapt_step(k, X2, r0, r1, pstar, sgn, T1, ymode, smode, tco, yco, sco, sp, 
             n += 2
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _groot(k, X2, lo, hi, glo, ymode, smode, tco, yco, sco, sp):
     """Root of g(p) = B(p) - x^2 in [lo, hi] given a sign change (bisection + secant)."""
     for _ in range(200):
@@ -321,14 +322,14 @@ def _groot(k, X2, lo, hi, glo, ymode, smode, tco, yco, sco, sp):
     return 0.5 * (lo + hi)
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _gval(k, p, X2, ymode, smode, tco, yco, sco, sp):
     """g(p) = b(p)^2 - x^2 on step k (the element is loaded where g > 0)."""
     t, tp, dA, dB, sq = _eval(k, p, ymode, smode, tco, yco, sco, sp)
     return dB - X2
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _slow_step(k, plo, X2, T1, ymode, smode, tco, yco, sco, sp, lam, sigma, tol, out,
                xk, wk, wg):
     """Accumulate int_{plo}^1 exp(lam (T1 - t)) dq(x, p) t'(p) dp per mode into out.
@@ -343,7 +344,7 @@ def _slow_step(k, plo, X2, T1, ymode, smode, tco, yco, sco, sp, lam, sigma, tol,
                     sp, lam, sigma, tol, out, xk, wk, wg)
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _zone_crossings(k, plo, X2, ymode, smode, tco, yco, sco, sp):
     """The zeros of g = b(p)^2 - x^2 in [plo, 1] and the nearest one just outside on either
     side (an onset integrated in every step), ascending."""
@@ -383,7 +384,7 @@ def _zone_crossings(k, plo, X2, ymode, smode, tco, yco, sco, sp):
     return roots
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _piece_tasks(k, plo, X2, roots, ymode, smode, tco, yco, sco, sp):
     """The pieces of [plo, 1] between the interior zeros, each as a task ``(r0, r1, p*,
     sign)`` of :func:`_adapt_step` (``sign`` 0: no square root to remove); returns the task
@@ -442,7 +443,7 @@ def _piece_tasks(k, plo, X2, roots, ymode, smode, tco, yco, sco, sp):
     return tr0, tr1, tps, tsg, nt
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _arel(k, X2, ymode, smode, tco, yco, sco, sp):
     """Release parameter p in step k: A(p) = x^2 (A decreasing through the step)."""
     lo = 0.0
@@ -459,7 +460,7 @@ def _arel(k, X2, ymode, smode, tco, yco, sco, sp):
     return 0.5 * (lo + hi)
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _element_d(X2, W2, free_start, L, T, DA, DB, SQ, ymode, smode, tco, yco, sco, sp,
                dBg, Kg, Ok, dBx, stiff, E, lam, cw, d0, alpha0, sigma, qscale, qtol,
                xk, wk, wg):
@@ -528,7 +529,7 @@ def _element_d(X2, W2, free_start, L, T, DA, DB, SQ, ymode, smode, tco, yco, sco
     return d
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _emat(L, T, lam):
     M = lam.size
     E = np.empty((max(L, 1), M))
@@ -538,7 +539,7 @@ def _emat(L, T, lam):
     return E
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _gap_integral(L, b, dBL, phis, external, T, DA, DB, SQ, ymode, smode, tco, yco, sco, sp,
                   dBg, Kg, Ok, dBx, stiff, lam, cw, d0, alpha0, sigma, qscale, qtol, gtol,
                   xk15, wk15, wg7, xk21, wk21, wg10, stats):
@@ -603,7 +604,7 @@ def _gap_integral(L, b, dBL, phis, external, T, DA, DB, SQ, ymode, smode, tco, y
     return total
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _ref_u(L, T, SQ, Ok, lam, cw, alpha0, sigma):
     """Displacement u_r(T[L]) of the reference element (load q_r, u_r(0) = 0)."""
     M = lam.size
