@@ -31,6 +31,11 @@ from numba import njit
 
 
 
+#: 0 as an argument of a kernel's call: numba compiles the callee once more for a literal 0
+#: (it specialises on integer constants, and on a count's initial 0 while it infers types).
+_ZERO = np.int64(0)
+
+
 @njit(cache=True)
 def young_reach(mu_max):
     """Steps from a root of ``B(s) = xi`` within which an element's load counts as a square
@@ -150,11 +155,12 @@ def path_roots(p0, p1, p2, xi, lo, hi, roots):
 @njit(cache=True)
 def _panel(p0, p1, p2, xi, a, b, root, side, mus, nm, s1, out):
     """Adds ``int_a^b e^{-mu_k (s1-s)} Q(s) ds`` to ``out`` by 6-point Gauss-Legendre; with
-    ``side = +1`` (-1) the load is a square root of ``s - root`` (``root - s``) and
-    ``s = root +- w^2`` removes it."""
+    ``side = +1.0`` (-1.0) the load is a square root of ``s - root`` (``root - s``) and
+    ``s = root +- w^2`` removes it (0.0: no substitution). ``side`` is a float: numba
+    compiles a kernel once per integer constant it is passed (and this one with its callers)."""
     if b <= a:
         return
-    if side == 0:
+    if side == 0.0:
         for i in range(6):
             s = a + (b - a) * GL6_X[i]
             q = load_at(p0, p1, p2, xi, s) * GL6_W[i] * (b - a)
@@ -217,7 +223,7 @@ def _graded_around(p0, p1, p2, xi, a, b, centre, width, mus, nm, mu_max, s1, out
             hi = lo + side * w
             if (hi - end) * side > 0.0:
                 hi = end
-            _piece(p0, p1, p2, xi, min(lo, hi), max(lo, hi), 0.0, 0, mus, nm, mu_max, s1, out)
+            _piece(p0, p1, p2, xi, min(lo, hi), max(lo, hi), 0.0, 0.0, mus, nm, mu_max, s1, out)
             lo = hi
             w *= 2.0
 
@@ -241,14 +247,14 @@ def _loaded_piece(p0, p1, p2, xi, a, b, n, r1, r2, reach, mus, nm, mu_max, s1, o
     if near_lo and near_hi:
         # An entry and an exit: each half substitutes from its own root.
         mid = 0.5 * (a + b)
-        _piece(p0, p1, p2, xi, a, mid, root_lo, 1, mus, nm, mu_max, s1, out)
-        _piece(p0, p1, p2, xi, mid, b, root_hi, -1, mus, nm, mu_max, s1, out)
+        _piece(p0, p1, p2, xi, a, mid, root_lo, 1.0, mus, nm, mu_max, s1, out)
+        _piece(p0, p1, p2, xi, mid, b, root_hi, -1.0, mus, nm, mu_max, s1, out)
     elif near_lo:
-        _piece(p0, p1, p2, xi, a, b, root_lo, 1, mus, nm, mu_max, s1, out)
+        _piece(p0, p1, p2, xi, a, b, root_lo, 1.0, mus, nm, mu_max, s1, out)
     elif near_hi:
-        _piece(p0, p1, p2, xi, a, b, root_hi, -1, mus, nm, mu_max, s1, out)
+        _piece(p0, p1, p2, xi, a, b, root_hi, -1.0, mus, nm, mu_max, s1, out)
     else:
-        _piece(p0, p1, p2, xi, a, b, 0.0, 0, mus, nm, mu_max, s1, out)
+        _piece(p0, p1, p2, xi, a, b, 0.0, 0.0, mus, nm, mu_max, s1, out)
 
 
 @njit(cache=True)
@@ -736,10 +742,10 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
     k_b = int(sc[S_K_BETA]) if beta1 > start else 0
     theta_b = math.acos(min(start / beta1, 1.0)) if k_b > 0 else 0.0
     first_b = 0 if (fresh and start == 0.0) else 1
-    m = 0
     y0 = np.zeros(max(nm, 1))
     ints = np.empty(max(nm, 1))
     work = np.empty((2, max(tau_arms.size, 1)))
+    m = np.int64(0)  # not a literal 0: see _ZERO
     for j in range(k_a + (hi - lo) + k_b + 1 - first_b):
         s0 = 0.0
         for k in range(nm):
@@ -827,7 +833,8 @@ def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
     virgin = beta1 > sc[S_XIMAX] * (1.0 + 1e-12) and beta1 > sc[S_BETA0]
     U_beta = 0.0 if virgin else math.nan
     U_alpha = H1 + _profile(sc, alpha1, prof) if alpha1 > 0.0 else centre
-    integral = free_gap_integral(xs, us, 0, n_in, alpha1, beta1, U_alpha, U_beta, sc[S_KINK])
+    integral = free_gap_integral(xs, us, _ZERO, xs.size, alpha1, beta1, U_alpha, U_beta,
+                                 sc[S_KINK])
     return integral
 
 
@@ -1280,7 +1287,7 @@ def replay_elements(rows, kink, row_Hf, xs, lam, z, ctil, d, tau_arms, V_inv, ma
             for i in range(idx.size):
                 for m in range(nm):
                     Y0[i, m] = Y[idx[i], m]
-            free_field(xs[idx], Y0, s0[idx], 0, idx.size, bp[0], bp[1], bp[2], mus, z * dt,
+            free_field(xs[idx], Y0, s0[idx], _ZERO, idx.size, bp[0], bp[1], bp[2], mus, z * dt,
                        ctil, d, nm, w3, Yn, U)
             for i in range(idx.size):
                 for m in range(nm):
