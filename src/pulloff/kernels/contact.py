@@ -557,12 +557,14 @@ def _split_integral(th, f, m, s, th_kink):
     extrapolated from its own nodes."""
     left_th = np.empty(s + 1)
     left_f = np.empty(s + 1)
-    left_th[:s] = th[:s]
-    left_f[:s] = f[:s]
     right_th = np.empty(m - s + 1)
     right_f = np.empty(m - s + 1)
-    right_th[1:] = th[s:m]
-    right_f[1:] = f[s:m]
+    # Loops, not slice assignments: numba compiles a shape check with a formatted message
+    # for each of those, into every caller.
+    for j in range(s):
+        left_th[j], left_f[j] = th[j], f[j]
+    for j in range(s, m):
+        right_th[j - s + 1], right_f[j - s + 1] = th[j], f[j]
     near_th = left_th[:s][::-1].copy()  # nearest the kink first
     near_f = left_f[:s][::-1].copy()
     left_th[s] = th_kink
@@ -948,7 +950,8 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     come back first."""
     _quadratic(edges[E_ALPHA_PREV], edges[E_ALPHA], alpha, edges[E_R], paths[0])
     _quadratic(edges[E_BETA_PREV], edges[E_BETA], beta, edges[E_R], paths[1])
-    paths[2, :] = lift
+    for i in range(3):  # (a slice assignment compiles a shape check)
+        paths[2, i] = lift[i]
     bp = paths[1]
     xs = xi[:n_all]
     lo = np.searchsorted(xs, min(edges[E_ALPHA], alpha) - _TINY)
@@ -1094,17 +1097,20 @@ def merge_sorted(arr, n, at, new):
     """Insert the rows ``new`` into the first ``n`` rows of ``arr`` (which has room), new row
     ``j`` before old row ``at[j]`` (``at`` ascending), in place: ``np.insert`` without its
     copies (a step's new elements, every step)."""
-    j = at.size - 1
-    for i in range(n - 1, -1, -1):
-        while j >= 0 and at[j] > i:
-            arr[i + j + 1] = new[j]
+    i, j = n - 1, at.size - 1
+    while j >= 0:  # row i + j + 1, from the end, takes old row i or new row j
+        old = i >= 0 and at[j] <= i
+        # Element by element (a row assignment compiles a shape check with a formatted
+        # message); numba drops the branch that does not fit arr's ndim before typing.
+        if arr.ndim == 1:
+            arr[i + j + 1] = arr[i] if old else new[j]
+        else:
+            for c in range(arr.shape[1]):
+                arr[i + j + 1, c] = arr[i, c] if old else new[j, c]
+        if old:
+            i -= 1
+        else:
             j -= 1
-        if j < 0:
-            return
-        arr[i + j + 1] = arr[i]
-    while j >= 0:
-        arr[j] = new[j]
-        j -= 1
 
 
 @njit(cache=True)
@@ -1196,7 +1202,8 @@ def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthe
         if flags[j] != 1:
             continue
         xs[j_new] = x_ev[j]
-        Ys[j_new] = Y_ev[j]
+        for k in range(Y_ev.shape[1]):  # (a row assignment compiles a shape check)
+            Ys[j_new, k] = Y_ev[j, k]
         if 0.0 < x_ev[j] <= alpha:
             status_new[j_new], tj_new[j_new] = 1, t1
         furthest[0] = max(furthest[0], x_ev[j])
@@ -1222,7 +1229,9 @@ def _replayed_contact_modes(x, H, Hf, maxwell, V_inv, sc, prof, out):
     if not maxwell:
         out[0] = H + G
         return
-    out[:V_inv.shape[0]] = np.dot(V_inv, Hf + G)
+    modes = np.dot(V_inv, Hf + G)
+    for k in range(modes.size):  # (a slice assignment compiles a shape check)
+        out[k] = modes[k]
 
 
 @njit(cache=True)
@@ -1275,7 +1284,8 @@ def replay_elements(rows, kink, row_Hf, xs, lam, z, ctil, d, tau_arms, V_inv, ma
             if maxwell:
                 _filtered_lift(row_Hf[k - 1], dt / tau_arms, hp, s_c, hf_c)
             else:
-                hf_c[:] = row_Hf[k - 1]
+                for i in range(hf_c.size):  # (a slice assignment compiles a shape check)
+                    hf_c[i] = row_Hf[k - 1, i]
             _replayed_contact_modes(xs[j], h_c, hf_c, maxwell, V_inv, sc, prof, Y[j])
             s0[j] = s_c
             free[j] = True
