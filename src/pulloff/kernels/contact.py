@@ -801,7 +801,7 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
 def _sort_gathered(xo, Yo, Uo, fo, m, nm):
     """The gathered elements in ascending ``x`` (stable: the existing ones keep their order),
     once a receding smooth edge's new elements went in ahead of the contact's own."""
-    order = np.argsort(xo[:m], kind="mergesort")
+    order = stable_argsort(xo[:m])
     x_s, U_s, f_s, Y_s = xo[:m][order], Uo[:m][order], fo[:m][order], Yo[:m][order]
     for j in range(m):
         xo[j], Uo[j], fo[j] = x_s[j], U_s[j], f_s[j]
@@ -1093,6 +1093,38 @@ def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw,
 
 
 @njit(cache=True)
+def _sorts_before(x, a, b):
+    """``x[a]`` sorts before ``x[b]`` in NumPy's order (nan last)."""
+    return x[a] < x[b] or (math.isnan(x[b]) and not math.isnan(x[a]))
+
+
+@njit(cache=True)
+def stable_argsort(x):
+    """``np.argsort(x, kind="mergesort")``: the same order (a stable sort's is unique), by a
+    bottom-up merge sort; numba's own compiles for seconds."""
+    n = x.size
+    order = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        order[i] = i
+    work = np.empty(n, dtype=np.int64)
+    width = 1
+    while width < n:
+        for lo in range(0, n, 2 * width):
+            mid, hi = min(lo + width, n), min(lo + 2 * width, n)
+            i, j = lo, mid
+            for k in range(lo, hi):  # a tie takes the left run's: stable
+                if j >= hi or (i < mid and not _sorts_before(x, order[j], order[i])):
+                    work[k] = order[i]
+                    i += 1
+                else:
+                    work[k] = order[j]
+                    j += 1
+        order, work = work, order
+        width *= 2
+    return order
+
+
+@njit(cache=True)
 def merge_sorted(arr, n, at, new):
     """Insert the rows ``new`` into the first ``n`` rows of ``arr`` (which has room), new row
     ``j`` before old row ``at[j]`` (``at`` ascending), in place: ``np.insert`` without its
@@ -1139,7 +1171,7 @@ def insert_batch(mesh, n, x, Y, status, D, tj, t_last):
     and ``tj``; all valid at ``t_last``) into the first ``n`` of ``mesh`` = (xi, Y, status, D,
     tj, t_last), which has room, keeping it sorted: as one-by-one inserts would."""
     xi_m, Y_m, status_m, D_m, tj_m, t_last_m = mesh
-    order = np.argsort(x, kind="mergesort")
+    order = stable_argsort(x)
     xs = x[order]
     at = np.searchsorted(xi_m[:n], xs)
     merge_sorted(xi_m, n, at, xs)
