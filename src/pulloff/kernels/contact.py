@@ -29,14 +29,17 @@ import math
 import numpy as np
 from numba import njit
 
-
+# Numba gives every kernel a C-callable wrapper (for use as a first-class function, which none
+# is here) and a Python entry, each compiled with it: seconds in all from an empty cache. No
+# kernel here gets the first; the private ones only kernels call (all but _filtered_lift and
+# _memory) go without the second too (called from Python, one would crash).
 
 #: 0 as an argument of a kernel's call: numba compiles the callee once more for a literal 0
 #: (it specialises on integer constants, and on a count's initial 0 while it infers types).
 _ZERO = np.int64(0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def young_reach(mu_max):
     """Steps from a root of ``B(s) = xi`` within which an element's load counts as a square
     root: beyond, the fitted Radau rule's error on ``sqrt(s - root)`` is below ~3e-8 of the
@@ -54,7 +57,7 @@ GL6_W = 0.5 * _w6
 GL2_X = 1.0 / math.sqrt(3.0)  # 2-point Gauss-Legendre node on [-1, 1]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def exp_moments(mu):
     """``(M0, M1, M2)``, ``M_k = int_0^1 exp(-mu (1 - s)) s^k ds``, stable for ``mu >= 0``."""
     if mu < 0.5:
@@ -78,7 +81,7 @@ def exp_moments(mu):
     return m0, m1, m2
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def fitted_radau3(mu, out):
     """Weights ``W_i`` with ``int_0^1 e^{-mu (1-s)} P(s) ds = sum W_i P(s_i)`` exactly for every
     quadratic ``P``, at the 3 Radau points ``s_i`` (for ``mu = 0`` the Radau rule itself)."""
@@ -92,12 +95,12 @@ def fitted_radau3(mu, out):
         out[i] = (m2 - (a + b) * m1 + a * b * m0) / den
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def path_value(p0, p1, p2, s):
     return p0 + s * (p1 + s * p2)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def load_at(p0, p1, p2, xi, s):
     """``Q = sqrt(B(s)^2 - xi^2)`` inside the zone, 0 beyond it."""
     b = path_value(p0, p1, p2, s)
@@ -107,7 +110,7 @@ def load_at(p0, p1, p2, xi, s):
     return math.sqrt(d * (b + xi))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def path_roots2(p0, p1, p2, xi, lo, hi):
     """``(count, r1, r2)``: the real roots of ``B(s) = xi`` in ``(lo, hi)``, ascending."""
     c = p0 - xi
@@ -141,7 +144,7 @@ def path_roots2(p0, p1, p2, xi, lo, hi):
     return n, r1, r2
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def path_roots(p0, p1, p2, xi, lo, hi, roots):
     """Real roots of ``B(s) = xi`` in ``(lo, hi)``, ascending, into ``roots``; returns how many."""
     n, r1, r2 = path_roots2(p0, p1, p2, xi, lo, hi)
@@ -152,7 +155,7 @@ def path_roots(p0, p1, p2, xi, lo, hi, roots):
     return n
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _panel(p0, p1, p2, xi, a, b, root, side, mus, nm, s1, out):
     """Adds ``int_a^b e^{-mu_k (s1-s)} Q(s) ds`` to ``out`` by 6-point Gauss-Legendre; with
     ``side = +1.0`` (-1.0) the load is a square root of ``s - root`` (``root - s``) and
@@ -185,7 +188,7 @@ _PANEL_EDGES = np.array([0.0, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 2
                          40.0])
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _piece(p0, p1, p2, xi, a, b, root, side, mus, nm, mu_max, s1, out):
     """``int_a^b e^{-mu_k (s1-s)} Q ds`` over one loaded piece: one panel where the exponential is
     flat across it, else panels graded away from ``b`` (where the kernel peaks) on the fastest
@@ -211,7 +214,7 @@ def _piece(p0, p1, p2, xi, a, b, root, side, mus, nm, mu_max, s1, out):
         distance *= 1.25
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _graded_around(p0, p1, p2, xi, a, b, centre, width, mus, nm, mu_max, s1, out):
     """Panels from ``centre`` outward, ``width, 2 width, 4 width, ...`` wide, each no wider
     than the kernel's scale allows (:func:`_piece`), over ``[a, b]``."""
@@ -228,7 +231,7 @@ def _graded_around(p0, p1, p2, xi, a, b, centre, width, mus, nm, mu_max, s1, out
             w *= 2.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _loaded_piece(p0, p1, p2, xi, a, b, n, r1, r2, reach, mus, nm, mu_max, s1, out):
     """One piece ``[a, b]`` between roots: skipped where the zone does not reach, else
     integrated with the square-root substitution from whichever root is near."""
@@ -257,7 +260,7 @@ def _loaded_piece(p0, p1, p2, xi, a, b, n, r1, r2, reach, mus, nm, mu_max, s1, o
         _piece(p0, p1, p2, xi, a, b, 0.0, 0.0, mus, nm, mu_max, s1, out)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def load_integrals(p0, p1, p2, xi, s0, s1, mus, nm, w3, out):
     """``out[k] = int_{s0}^{s1} e^{-mu_k (s1-s)} Q(s) ds`` for one element (the whole step
     ``[0, 1]``, or part of it for an element the contact edge releases or captures inside the
@@ -303,7 +306,7 @@ def load_integrals(p0, p1, p2, xi, s0, s1, mus, nm, w3, out):
     return load_at(p0, p1, p2, xi, s1)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def advance_free(Y, i, integrals, decay, zdt, ctil, d, q_end, nm):
     """Advance element ``i``'s modes by one step and return its displacement ``U``."""
     u = d * q_end
@@ -316,7 +319,7 @@ def advance_free(Y, i, integrals, decay, zdt, ctil, d, q_end, nm):
 
 # --- gap integral ------------------------------------------------------------------------------
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _basis_integral(tj, r0, r1, r2, a, b):
     """``int_a^b prod_m (t - r_m) / (tj - r_m) dt`` over the three other nodes ``r``."""
     den = (tj - r0) * (tj - r1) * (tj - r2)
@@ -328,7 +331,7 @@ def _basis_integral(tj, r0, r1, r2, a, b):
     return ib / den
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _cubic_weights(t0, t1, t2, t3, a, b, w):
     """``w[j] = int_a^b l_j(t) dt`` for the Lagrange cubic through ``t0..t3``."""
     w[0] = _basis_integral(t0, t1, t2, t3, a, b)
@@ -343,7 +346,7 @@ def _cubic_weights(t0, t1, t2, t3, a, b, w):
 SPREAD = 0.25
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _spread_stencil(t, n, j, idx):
     """Up to 4 nodes for the interval ``t[j]..t[j+1]``: its ends, then outward one side at a
     time (left first), each at least ``SPREAD`` times the interval from the last one taken on
@@ -371,7 +374,7 @@ def _spread_stencil(t, n, j, idx):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _lagrange_integral_weights(ts, m, a, b, w):
     """``w[k] = int_a^b l_k(t) dt`` for the Lagrange basis through ``ts[:m]`` (m <= 4), by
     2-point Gauss-Legendre, exact for these cubics."""
@@ -388,7 +391,7 @@ def _lagrange_integral_weights(ts, m, a, b, w):
             w[k] += half * lk
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def piecewise_cubic_integral(t, f, n):
     """``int_{t[0]}^{t[n-1]} f dt`` of the piecewise cubic through nodes ``t`` (ascending,
     non-uniform): each interval uses the cubic through its well-spread neighbours
@@ -416,7 +419,7 @@ def piecewise_cubic_integral(t, f, n):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def extrapolate_cubic(t, f, n, x):
     """The polynomial through up to 4 of the first nodes, evaluated at ``x`` (outside them):
     the first, then each next one at least ``SPREAD`` times the distance to ``x`` beyond the
@@ -441,7 +444,7 @@ def extrapolate_cubic(t, f, n, x):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def angle(xi, beta):
     """``acos(xi / beta)`` without cancellation near ``xi = beta``."""
     r2 = (beta - xi) * (beta + xi)
@@ -450,7 +453,7 @@ def angle(xi, beta):
 
 # --- the indenter profile ----------------------------------------------------------------------
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def sin_power_integral(n, theta):
     """``int_0^theta sin(t)^n dt`` for ``n >= 0``: closed forms for n = 0, 1, 2; otherwise
     Gauss-Legendre after ``t = theta w^(1/(n+1))``-like smoothing (24 nodes, ~1e-13)."""
@@ -470,7 +473,7 @@ def sin_power_integral(n, theta):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def profile_integral(C, n, alpha, beta):
     """``int_0^alpha C x^n / sqrt(beta^2 - x^2) dx`` (a power-law MDR profile, ``alpha <= beta``)."""
     if C == 0.0 or alpha <= 0.0:
@@ -481,7 +484,7 @@ def profile_integral(C, n, alpha, beta):
 
 # --- the field and the gap -------------------------------------------------------------------
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def free_field(xi, Y0, s0, lo, hi, p0, p1, p2, mus, zdt, ctil, d, nm, w3, Y_out, U_out):
     """Free elements ``lo..hi-1`` advanced from ``s0[i]`` (0, or where the edge released them)
     to the end of the step under the load of the zone-end path ``p``: modes into ``Y_out``,
@@ -497,7 +500,7 @@ def free_field(xi, Y0, s0, lo, hi, p0, p1, p2, mus, zdt, ctil, d, nm, w3, Y_out,
         U_out[i] = u
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta, kink=0.0):
     """``int_alpha^beta U / sqrt(beta^2 - xi^2) dxi = int_0^theta_a U dtheta`` with
     ``xi = beta cos(theta)``: the piecewise cubic through the nodes strictly inside, ``U_alpha``
@@ -549,7 +552,7 @@ def free_gap_integral(xi, U, lo, hi, alpha, beta, U_alpha, U_beta, kink=0.0):
     return piecewise_cubic_integral(th, f, m)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _split_integral(th, f, m, s, th_kink):
     """The piecewise cubic integral of ``f(th)`` with no stencil across ``th_kink``, between
     nodes ``s - 1`` and ``s``, where ``f`` is continuous but its slope jumps (a stencil across
@@ -584,7 +587,7 @@ R_GAP, R_EDGE_LOAD, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(6)
  S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH, S_KINK, S_LIVE_END, S_N) = range(20)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def path_root(p0, p1, p2, x):
     """The fraction of the step where the path passes ``x`` (clamped to the step)."""
     n, r1, r2 = path_roots2(p0, p1, p2, x, -1e-12, 1.0 + 1e-12)
@@ -593,7 +596,7 @@ def path_root(p0, p1, p2, x):
     return min(max(r1, 0.0), 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def table_g(knots, jumps, x):
     """``g(x) = sum_j s_j x acos(r_j/x)`` of a tabulated tip written as ramps
     ``f = sum_j s_j (r - r_j)_+`` (exact for the piecewise-linear interpolant)."""
@@ -606,7 +609,7 @@ def table_g(knots, jumps, x):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def table_f(knots, jumps, r):
     total = 0.0
     for j in range(knots.size):
@@ -615,7 +618,7 @@ def table_f(knots, jumps, r):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def table_contact_integral(knots, jumps, alpha, beta):
     """``int_0^alpha g / sqrt(beta^2 - x^2) dx = sum_j s_j int_{r_j}^alpha atan(rho/c) dr``
     (``rho = sqrt(alpha^2 - r^2)``, ``c = sqrt(beta^2 - alpha^2)``), each by its
@@ -634,7 +637,7 @@ def table_contact_integral(knots, jumps, alpha, beta):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def table_g_integral(knots, jumps, alpha):
     """``int_0^alpha g dx``: per ramp ``alpha^2/2 acos(r_j/alpha) - r_j/2 sqrt(alpha^2 - r_j^2)``."""
     total = 0.0
@@ -646,7 +649,7 @@ def table_g_integral(knots, jumps, alpha):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _profile(sc, x, prof):
     """``g(x)`` of the indenter: a power law, a table (``prof = (knots, jumps)``), or 0 (a
     flat punch)."""
@@ -657,7 +660,7 @@ def _profile(sc, x, prof):
     return sc[S_C_G] * abs(x) ** sc[S_N_G]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, x, out):
     """``D_i e^{-(t - tj)/tau_i}`` of a contact element at ``x``, linear between the contact
     elements (0 with none); returns ``sum_i kappa_i`` of it."""
@@ -688,7 +691,7 @@ def _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, x, out):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _filtered_lift(Hf0, arm_mus, hp, s, out):
     """The arms' filtered lift ``Hf`` at fraction ``s`` of the step (``hp`` the lift path)."""
     for i in range(Hf0.size):
@@ -698,7 +701,7 @@ def _filtered_lift(Hf0, arm_mus, hp, s, out):
                   + mu * (hp[0] * m0 + hp[1] * s * m1 + hp[2] * s * s * m2))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _contact_modes(x, s_c, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj, n_all,
                    kappa_arms, tau_arms, nm, prof, work, out):
     """Modes of a contact element at ``x`` released at fraction ``s_c`` (``work``: two rows
@@ -719,7 +722,7 @@ def _contact_modes(x, s_c, sc, hp, Hf0, arm_mus, V_inv, xi, status, D, tj, n_all
         out[k] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out):
     """The elements a trial step advances, in ascending ``x``: new ones where a receding flat
     punch releases the solid, the existing ones ``lo..hi-1``, new ones where the zone end
@@ -797,7 +800,7 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _sort_gathered(xo, Yo, Uo, fo, m, nm):
     """The gathered elements in ascending ``x`` (stable: the existing ones keep their order),
     once a receding smooth edge's new elements went in ahead of the contact's own."""
@@ -809,7 +812,7 @@ def _sort_gathered(xo, Yo, Uo, fo, m, nm):
             Yo[j, k] = Y_s[j, k]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
     """The free part of the gap integral (and the centre element's displacement into ``res``)."""
     H1 = sc[S_H1]
@@ -840,7 +843,7 @@ def _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res):
     return integral
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out, res):
     """One trial step's end for trial edges ``alpha1``, ``beta1`` (and the lift in ``sc``):
     every element advanced (:func:`_gather`), then into ``res`` the gap at ``b``, the line
@@ -893,7 +896,7 @@ def evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, pro
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha):
     """``int_0^alpha`` of the arms' contact memory (trapezoid over the contact elements)."""
     total = 0.0
@@ -928,7 +931,7 @@ E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING = range(6)
 _TINY = 1e-13
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _quadratic(prev, now, new, r, out):
     """``out`` = the quadratic path through ``(-r, prev)``, ``(0, now)``, ``(1, new)`` (linear
     through the last two where ``r`` or ``prev`` is nan): as ``contact_step.quadratic_path``."""
@@ -939,7 +942,7 @@ def _quadratic(prev, now, new, r, out):
     out[0], out[1], out[2] = now, new - now - p2, p2
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     """What a trial step with edges ``alpha``, ``beta`` advances: its paths into ``paths``
     (the edges' quadratics through the last instants, the lift's ``lift``), the released
@@ -968,7 +971,7 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     return lo, hi
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _no_state(nm):
     """``(lo, hi, m, out, res)`` of a trial that could not be evaluated (see
     :func:`trial_state`): empty."""
@@ -976,7 +979,7 @@ def _no_state(nm):
     return 0, 0, 0, out, np.empty(R_N)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def trial_state(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     """``gap(b) - 1`` at the end of a step with trial edges ``alpha``, ``beta`` (what
     ``Step.evaluate`` gives), with the rest of that evaluation: ``(lo, hi)``, the rows
@@ -1002,7 +1005,7 @@ def trial_state(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     return res[R_GAP] - 1.0, lo, hi, m, out, res
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def flat_edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
     """The zone end the edge condition puts with a flat punch's edge at ``alpha``, as
     ``contact_phases.edge_zone`` computes it (the same sums, in the same order)."""
@@ -1026,7 +1029,7 @@ def flat_edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
     return math.sqrt(alpha * alpha + q * q)  # (numba's hypot rounds otherwise)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _edge_residual(x, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
     """The residual a phase's secant searches: a flat punch's receding edge at ``x`` with the
     zone end from the edge condition (``alpha`` nan), or the zone end at ``x`` with the edge
@@ -1044,7 +1047,7 @@ _STALL = 1e-13
 _SMALL_RESIDUAL = 1e-9
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw, prof, sc0,
                 edges, lift, n_all):
     """``contact_phases._secant`` on :func:`_edge_residual` (``alpha``: see there), step for
@@ -1092,13 +1095,13 @@ def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw,
     return math.nan, last
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _sorts_before(x, a, b):
     """``x[a]`` sorts before ``x[b]`` in NumPy's order (nan last)."""
     return x[a] < x[b] or (math.isnan(x[b]) and not math.isnan(x[a]))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def stable_argsort(x):
     """``np.argsort(x, kind="mergesort")``: the same order (a stable sort's is unique), by a
     bottom-up merge sort; numba's own compiles for seconds."""
@@ -1124,7 +1127,7 @@ def stable_argsort(x):
     return order
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def merge_sorted(arr, n, at, new):
     """Insert the rows ``new`` into the first ``n`` rows of ``arr`` (which has room), new row
     ``j`` before old row ``at[j]`` (``at`` ascending), in place: ``np.insert`` without its
@@ -1145,14 +1148,14 @@ def merge_sorted(arr, n, at, new):
             j -= 1
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def fitted_radau3_rows(mus, out):
     """:func:`fitted_radau3` for every ``mus[k]`` into ``out[k]`` (one call per step)."""
     for k in range(mus.size):
         fitted_radau3(mus[k], out[k])
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _rows(new, order, width):
     """``new[order]`` with ``width`` columns (missing ones 0: an elastic element has no
     modes, while the mesh keeps one column)."""
@@ -1165,7 +1168,7 @@ def _rows(new, order, width):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def insert_batch(mesh, n, x, Y, status, D, tj, t_last):
     """Insert new elements (at ``x``, any order, with their rows of ``Y``, ``D``, ``status``
     and ``tj``; all valid at ``t_last``) into the first ``n`` of ``mesh`` = (xi, Y, status, D,
@@ -1186,7 +1189,7 @@ def insert_batch(mesh, n, x, Y, status, D, tj, t_last):
     return where
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthest):
     """A step's end into the mesh when nothing needs the Python path (no free element captured
     by the edge, no new element beyond ``live_end``, room for the new ones): every advanced
@@ -1252,7 +1255,7 @@ def commit_plain(mesh, n, lo, hi, x_ev, Y_ev, flags, alpha, t1, live_end, furthe
 
 
 # --- new elements replayed from the rows ----------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _replayed_contact_modes(x, H, Hf, maxwell, V_inv, sc, prof, out):
     """Modes of a contact element at ``x`` (lift ``H``, arms' filtered lift ``Hf``):
     Kelvin-Voigt its displacement, Maxwell its dashpots (a flat punch's bonded elements all
@@ -1266,7 +1269,7 @@ def _replayed_contact_modes(x, H, Hf, maxwell, V_inv, sc, prof, out):
         out[k] = modes[k]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def replay_elements(rows, kink, row_Hf, xs, lam, z, ctil, d, tau_arms, V_inv, maxwell, sc,
                     prof, Y):
     """``contact_replay.replay`` compiled: the modes (rows of ``Y``, zeroed) at the last row
