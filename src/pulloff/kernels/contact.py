@@ -1030,16 +1030,13 @@ def flat_edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
-def _edge_residual(x, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all):
-    """The residual a phase's secant searches: a flat punch's receding edge at ``x`` with the
-    zone end from the edge condition (``alpha`` nan), or the zone end at ``x`` with the edge
-    held at ``alpha``; with the edges tried and the rest of :func:`trial_state`."""
+def _trial_edges(x, alpha, mesh, law, stepw, prof, sc0, n_all):
+    """The edges a phase's secant tries at ``x``: a flat punch's receding edge at ``x`` with
+    the zone end from the edge condition (``alpha`` nan), or the zone end at ``x`` with the
+    edge held at ``alpha``."""
     if math.isnan(alpha):
-        a, b = x, flat_edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
-    else:
-        a, b = alpha, x
-    f, lo, hi, m, out, res = trial_state(a, b, mesh, law, stepw, prof, sc0, edges, lift, n_all)
-    return f, (a, b, lo, hi, m, out, res)
+        return x, flat_edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
+    return alpha, x
 
 
 _XTOL = 1e-14
@@ -1050,19 +1047,39 @@ _SMALL_RESIDUAL = 1e-9
 @njit(cache=True, no_cfunc_wrapper=True)
 def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw, prof, sc0,
                 edges, lift, n_all):
-    """``contact_phases._secant`` on :func:`_edge_residual` (``alpha``: see there), step for
-    step (the same iterates, brackets and stopping rules): the root, or nan where it gives
-    up; and the evaluation at the last iterate tried (the root, where one is returned), as
-    :func:`_edge_residual` gives it."""
+    """``contact_phases._secant`` on ``gap(b) - 1`` of :func:`trial_state` at the edges
+    :func:`_trial_edges` puts at ``x``, step for step (the same iterates, brackets and
+    stopping rules): the root, or nan where it gives up; and the evaluation at the last
+    iterate tried (the root, where one is returned): its edges and the rest of
+    :func:`trial_state`."""
     x0, f0 = x_held, f_held
     x1 = min(max(x_guess, lo), hi)
     if x1 == x0:
         lo0, hi0, m, out, res = _no_state(stepw[0].size)
         return math.nan, (math.nan, math.nan, lo0, hi0, m, out, res)
-    f1, last = _edge_residual(x1, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
     bracketed, b_lo, b_hi = False, 0.0, 0.0
     slope = math.nan
-    for _ in range(40):
+    x2 = x1
+    for it in range(41):
+        # One call site of trial_state, at x1 first, then at each new iterate x2: with two
+        # (or a kernel between), numba's first compile took ~4 s longer.
+        a, b = _trial_edges(x2, alpha, mesh, law, stepw, prof, sc0, n_all)
+        f2, lo2, hi2, m2, out2, res2 = trial_state(a, b, mesh, law, stepw, prof, sc0, edges,
+                                                   lift, n_all)
+        last = (a, b, lo2, hi2, m2, out2, res2)
+        if it == 0:
+            f1 = f2
+        else:
+            if bracketed and not math.isnan(f2):
+                if (f2 > 0.0) != (f1 > 0.0):
+                    b_lo, b_hi = min(x1, x2), max(x1, x2)
+                else:
+                    keep = x0 if (f0 > 0.0) != (f2 > 0.0) else (
+                        b_lo if x2 > 0.5 * (b_lo + b_hi) else b_hi)
+                    b_lo, b_hi = min(keep, x2), max(keep, x2)
+            x0, f0, x1, f1 = x1, f1, x2, f2
+            if it == 40:
+                break
         if math.isnan(f1):
             return math.nan, last
         if abs(x1 - x0) > 1e-9 * max(abs(x1), 1e-300):
@@ -1083,15 +1100,6 @@ def edge_secant(x_held, f_held, x_guess, lo, hi, reach, alpha, mesh, law, stepw,
             x2 = 0.5 * (b_lo + b_hi)
         if not (lo <= x2 <= hi) or abs(x2 - x_held) > reach:
             return math.nan, last
-        f2, last = _edge_residual(x2, alpha, mesh, law, stepw, prof, sc0, edges, lift, n_all)
-        if bracketed and not math.isnan(f2):
-            if (f2 > 0.0) != (f1 > 0.0):
-                b_lo, b_hi = min(x1, x2), max(x1, x2)
-            else:
-                keep = x0 if (f0 > 0.0) != (f2 > 0.0) else (
-                    b_lo if x2 > 0.5 * (b_lo + b_hi) else b_hi)
-                b_lo, b_hi = min(keep, x2), max(keep, x2)
-        x0, f0, x1, f1 = x1, f1, x2, f2
     return math.nan, last
 
 
