@@ -486,3 +486,33 @@ def test_a_relaxation_layer_below_the_smallest_float_is_the_elastic_limit():
     """c / (k dt) underflowing to zero (or dt overflowing) ends at once with R = 1/k."""
     assert K._youngest_interval_weights(1.0, 5e-324, 10.0) == (0.5, 0.5)
     assert K._youngest_interval_weights(1e200, 1e-200, 1e100) == (0.5e-200, 0.5e-200)
+
+
+@settings(max_examples=200, deadline=None)
+@given(x=st.lists(st.one_of(st.sampled_from([0.0, 1.0, -1.0, math.nan, math.inf]),
+                            st.floats(-5.0, 5.0)), max_size=70))
+def test_property_the_compiled_stable_argsort_is_numpys(x):
+    """kernels.contact.stable_argsort replaced np.argsort(kind="mergesort") (numba's compiles
+    for seconds): the same order, ties (kept in input order) and nan (last) included."""
+    from pulloff.kernels import contact as C
+
+    x = np.array(x, dtype=float)
+    np.testing.assert_array_equal(C.stable_argsort(x), np.argsort(x, kind="stable"))
+
+
+@settings(max_examples=200, deadline=None)
+@given(n=st.integers(0, 12), data=st.data(), two_d=st.booleans())
+def test_property_merge_sorted_inserts_as_numpy_does(n, data, two_d):
+    """kernels.contact.merge_sorted (element by element, in place) against np.insert."""
+    from pulloff.kernels import contact as C
+
+    k = data.draw(st.integers(0, 6))
+    at = np.sort(np.array(data.draw(st.lists(st.integers(0, n), min_size=k, max_size=k)),
+                          dtype=np.int64))
+    shape = (lambda rows: (rows, 3)) if two_d else (lambda rows: (rows,))
+    old = np.arange(float(np.prod(shape(n)))).reshape(shape(n))
+    new = -1.0 - np.arange(float(np.prod(shape(k)))).reshape(shape(k))
+    arr = np.full(shape(n + k + 2), np.nan)
+    arr[:n] = old
+    C.merge_sorted(arr, n, at, new)
+    np.testing.assert_array_equal(arr[:n + k], np.insert(old, at, new, axis=0))
