@@ -7,7 +7,7 @@ from pathlib import Path
 def cache_is_warm() -> bool:
     """Whether numba's disk cache already holds this package's compiled kernels (else the
     first call compiles them: measured from an empty cache on a 2-core machine, 7-9 s for
-    the seed's onset and about 69 s for the moving-edge kernels)."""
+    the seed's onset and 38-45 s for the moving-edge kernels)."""
     from numba.core.config import CACHE_DIR
 
     where = Path(CACHE_DIR) if CACHE_DIR else Path(__file__).parent / "__pycache__"
