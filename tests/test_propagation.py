@@ -114,7 +114,7 @@ def test_onset_agrees_with_the_seed_model_solver():
 def test_three_levels_converging_at_up_to_fourth_order_stop_with_an_honest_estimate(
         monkeypatch):
     """sls_finite_punch at 1e-4 m/s: its levels n = 8, 16, 32 measure order 3.1, above the
-    3 an extrapolation has once asymptotic. The ladder trusts three levels up to order 4
+    method's 2 and the old bound of 3. The ladder trusts three levels up to order 4
     (measured on the rate sweep's 50 speeds: estimates 1.2-9.5x the error there; a fourth
     level doubled those runs): it stops on them, within 10x of the reference's error
     (measured: error 3.2e-6, estimate 1.6e-5)."""

@@ -1142,7 +1142,10 @@ def stable_argsort(x):
 def merge_sorted(arr, n, at, new):
     """Insert the rows ``new`` into the first ``n`` rows of ``arr`` (which has room), new row
     ``j`` before old row ``at[j]`` (``at`` ascending), in place: ``np.insert`` without its
-    copies (a step's new elements, every step)."""
+    copies (a step's new elements, every step). Rows of ``new`` as wide as ``arr``'s (no
+    broadcasting, unlike ``np.insert``)."""
+    if arr.ndim == 2 and new.shape[1] != arr.shape[1]:
+        raise ValueError("merge_sorted: new rows must be as wide as arr's")
     i, j = n - 1, at.size - 1
     while j >= 0:  # row i + j + 1, from the end, takes old row i or new row j
         old = i >= 0 and at[j] <= i

@@ -28,16 +28,20 @@ ORDER = ladder.Order(1.0, 2.0)
 #: A pull's end when the scene gives no t_max, in frozen onset times.
 DEFAULT_SPAN = 100.0
 #: The ladder's first level: a flat punch's pull and a smooth indenter's path. From 8 (not
-#: 16) the first three levels are trusted only where they measure an order of at most
-#: ``ORDER.high + 2``: from 8 without that check finite_punch_internal's estimate at rtol
-#: 1e-3 was 32x its error (its levels at n = 8, 16, 32 measure order 4.4; at 16, 32, 64
-#: 1.9). The bound was ``ORDER.high + 1`` (the order an extrapolation has once asymptotic);
-#: measured on the 50 speeds of benchmarks/sls_rate_sweep.py at rtol 1e-4 against runs at
-#: 1e-6, the 11 whose first three levels measure 3 to 4 had estimates 1.2-9.5x their error,
-#: and their fourth level cost as much as the first three (on 14 reference scenes at rtol
-#: 1e-3 and 1e-4 every estimate stays 0.98-6.5x its error with the bound at 4;
-#: benchmarks/contact_estimate.py). On the shipped smooth paths the levels from 8 never
-#: stopped before n = 64, and the n = 8 level only added 8-20 % to their time.
+#: 16) the first three levels are trusted only where the order they measure (of the levels
+#: themselves, 2 once asymptotic) is at most 4: a higher one says the first level is too
+#: coarse for the asymptotic range, and its extrapolation's estimate far too cautious (from
+#: 8 without the check finite_punch_internal's estimate at rtol 1e-3 was 32x its error; its
+#: levels at n = 8, 16, 32 measure order 4.4, at 16, 32, 64 1.9). The bound is empirical.
+#: It was 3; measured on the 50 speeds of benchmarks/sls_rate_sweep.py at rtol 1e-4 against
+#: runs at 1e-6, the 11 whose first three levels measure 3 to 4 had estimates 1.2-9.5x their
+#: error (the extrapolation at order 2 of levels converging faster can be further off than
+#: the finest level, up to 4x at order 4, but the estimate includes its correction), and
+#: their fourth level cost as much as the first three. On the 14 scenes of
+#: benchmarks/contact_estimate.py at rtol 1e-3 and 1e-4 every estimate stays 0.98-6.5x its
+#: error with the bound at 4 (0.98: separation_kv at 1e-2 m/s and rtol 1e-4, the same with
+#: the bound at 3). On the shipped smooth paths the levels from 8 never stopped before
+#: n = 64, and the n = 8 level only added 8-20 % to their time.
 _FIRST_N = {True: 8, False: 16}
 _FIRST_ORDER_MAX = ORDER.high + 2.0
 

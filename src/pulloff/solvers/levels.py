@@ -54,9 +54,9 @@ def _floats(v) -> list:
 def _scale_floats(v: list, floor) -> list:
     """:func:`_scale` over Python floats (nan wherever numpy's maximum gives nan)."""
     if floor is None:
-        return [abs(x) for x in v]
+        return _Floats(abs(x) for x in v)
     floors = np.broadcast_to(np.asarray(floor, dtype=float), (len(v),)).tolist()
-    return [a if (a != a or a >= f) else f for a, f in zip((abs(x) for x in v), floors)]
+    return _Floats(a if (a != a or a >= f) else f for a, f in zip((abs(x) for x in v), floors))
 
 
 def same_events(values: Sequence[np.ndarray]) -> bool:
@@ -220,7 +220,7 @@ def _pairwise(v: Sequence[list], p: float) -> list[list]:
     """The Richardson extrapolation at order ``p`` of each pair of consecutive levels (step
     ratio 2, outputs as Python floats), coarsest pair first."""
     f = 1.0 / (2.0 ** p - 1.0)
-    return [[b + (b - a) * f for a, b in zip(coarse, fine)]
+    return [_Floats(b + (b - a) * f for a, b in zip(coarse, fine))
             for coarse, fine in zip(v[:-1], v[1:])]
 
 
