@@ -204,7 +204,7 @@ def extrapolate_measured(values: Sequence[np.ndarray], order: Order, floor=None,
         # 7e-6 apart) refined to n = 128, three times the time.
         return v2.copy(), raw_estimate
     p = min(order.high, max(order.low, measured))
-    e1, e2 = (np.array(e) for e in _pairwise([_floats(x) for x in (v0, v1, v2)], p))
+    e1, e2 = (np.array(e) for e in _pairwise([_floats(x) for x in values[-3:]], p))
     scale = _scale(e2, floor)
     mask = np.isfinite(e2) & np.isfinite(e1) & (scale != 0)
     if not np.any(mask):
