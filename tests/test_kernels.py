@@ -516,3 +516,30 @@ def test_property_merge_sorted_inserts_as_numpy_does(n, data, two_d):
     arr[:n] = old
     C.merge_sorted(arr, n, at, new)
     np.testing.assert_array_equal(arr[:n + k], np.insert(old, at, new, axis=0))
+
+
+@settings(max_examples=200, deadline=None)
+@given(old=st.lists(st.floats(0.0, 1.0), max_size=60, unique=True),
+       alpha=st.floats(0.0, 0.9), beta=st.floats(0.05, 1.0), shrink=st.floats(0.0, 0.5),
+       dtheta=st.floats(1e-4, 0.3), count=st.integers(1, 20))
+def test_property_a_receding_ends_targets_are_new_spaced_and_inside(old, alpha, beta, shrink,
+                                                                    dtheta, count):
+    """kernels.contact.end_targets against its definition in Python: for each end (the
+    present, the predicted), ``b cos(k dtheta)`` inside ``(alpha, beta)`` and not within 0.4
+    of the angle spacing of an element or of a target taken before; ascending."""
+    from pulloff.kernels import contact as C
+
+    xi = np.sort(np.array(old + [7.0]))  # (an element beyond, as the mesh's archived side)
+    n = xi.size - 1
+    ends = np.array([beta, beta * (1.0 - shrink)])
+    out = np.empty(2 * count)
+    taken = C.end_targets(xi, n, alpha, ends, dtheta, count, out)
+    expected = []
+    for b in ends:
+        for k in range(1, count + 1):
+            x = b * math.cos(k * dtheta)
+            tol = 0.4 * b * max(math.sin(k * dtheta) * dtheta, 0.5 * dtheta**2)
+            if (alpha < x < beta and all(abs(x - y) > tol for y in xi[:n])
+                    and all(abs(x - y) > tol for y in expected)):
+                expected.append(x)
+    np.testing.assert_array_equal(out[:taken], np.sort(expected))

@@ -591,9 +591,11 @@ def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
     level, and the first step after the onset (1/16 of the last bonded one) jumped past
     the peak: the levels n = 16, 32, 64 missed t_separation by 1.45e-3, 1.31e-3, 5.6e-4 and
     the peak force by 1.9e-4, 1.5e-4, 4.4e-5, and the ladder went to n = 512 at rtol 1e-4.
-    Measured now: t_separation 7.4e-5, 3.0e-5, 1.2e-5; peak 4.0e-6, 1.3e-6, 3.3e-7 (with the
-    bonded phase's steps from a force range of 1e-3: 6.4e-5, 2.3e-5, 7.4e-6 and 1.4e-6,
-    4.2e-7, 9.3e-8, the peak stalling on the finer levels of other speeds)."""
+    With the growth measured in e-folds: t_separation 7.4e-5, 3.0e-5, 1.2e-5 (order 1.3),
+    peak 4.0e-6, 1.3e-6, 3.3e-7, the receding end's gap integral then under-resolved. With
+    elements replayed evenly in angle next to it (contact_replay.fill_receding_end), measured:
+    t_separation 7.1e-6, 1.4e-6, 1.7e-7 (order 2.3, 3.1), peak 8.8e-7, 6.4e-8, 3.1e-8 (the
+    last at the reference's own estimate, 3.5e-8)."""
     ref = REFERENCE["sls_finite_punch_v1e-7"]
     scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
                        overrides=["model.until=separation", "loading.v=1e-7"])
@@ -603,11 +605,11 @@ def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
         errors[n] = {name: abs(summary[name] / ref[name] - 1.0)
                      for name in ("t_separation", "F_peak_total")}
     sep = [errors[n]["t_separation"] for n in (16, 32, 64)]
-    assert sep[0] > 2.0 * sep[1] > 4.0 * sep[2], errors  # converging, not stalled
-    assert sep[2] < 2e-5, errors
+    assert sep[0] > 4.0 * sep[1] > 16.0 * sep[2], errors  # second order or better
+    assert sep[2] < 5e-7, errors
     peak = [errors[n]["F_peak_total"] for n in (16, 32, 64)]
-    assert peak[0] > 2.0 * peak[1] > 4.0 * peak[2], errors
-    assert peak[2] < 1e-6, errors
+    assert peak[0] > 4.0 * peak[1], errors
+    assert peak[1] < 2e-7 and peak[2] < 1e-7, errors
 
 
 def test_a_prony_punchs_zone_alone_is_not_lost_to_the_landing_on_a_zero(monkeypatch):
@@ -763,6 +765,54 @@ def test_an_element_replayed_from_the_rows_has_the_state_a_resident_one_has(conf
     np.testing.assert_allclose(replayed[:, :modes], resident, rtol=0.0, atol=1e-12 * scale)
     if now.alpha > 0.0:
         assert contact_replay.replay(stepper, np.array([0.5 * now.alpha])) is None
+
+
+def test_a_replay_started_where_the_memory_has_decayed_is_the_whole_replay():
+    """contact_replay.replay starts new elements at rest from the last row before which
+    their slowest mode has decayed 37 e-folds (a standard linear solid pulled at 1e-7 m/s,
+    to its onset: the arm forgets in a fraction of the pull). The modes are those of a replay
+    from t = 0 to rounding (measured: identical), and most rows are skipped."""
+    from pulloff.kernels import contact as K
+
+    scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
+                       overrides=["model.until=detach", "loading.v=1e-7"])
+    stepper = contact.run_level(scene, 16)
+    now, law = stepper.now, stepper.setup.law
+    xs = np.linspace(now.alpha, now.beta, 14)[1:-1]
+    rows, kink, row_Hf = contact_replay._history(stepper)
+    first = contact_replay._forgotten_before(rows, law, xs)
+    assert first > rows.shape[0] // 2, (first, rows.shape[0])
+    modes = {}
+    for start in (0, first):
+        Y = np.zeros((xs.size, law.n_modes))
+        assert K.replay_elements(rows, kink, row_Hf, start, xs, law.lam, law.z, law.ctil,
+                                 law.d, law.tau_arms, law.V_inv, law.maxwell,
+                                 stepper.step_constants, stepper.setup.indenter.table, Y)
+        modes[start] = Y
+    scale = np.max(np.abs(modes[0]))
+    assert scale > 0.0
+    np.testing.assert_allclose(modes[first], modes[0], rtol=0.0, atol=1e-14 * scale)
+    np.testing.assert_array_equal(contact_replay.replay(stepper, xs), modes[first])
+
+
+def test_elements_are_replayed_next_to_a_receding_end_only_where_its_memory_is_short(
+        monkeypatch):
+    """contact_replay.fill_receding_end: a standard linear solid pulled at 1e-7 m/s recedes
+    over elements spaced for its bonded zone while its arm's memory spans a tiny angle at
+    the end, and gets new elements there; seed_flat_punch's end recedes slowly against its
+    memory and gets none (its levels are the same with and without)."""
+    placed = []
+    fill = contact_replay.fill_receding_end
+    monkeypatch.setattr(contact_replay, "fill_receding_end",
+                        lambda stepper: placed.append(fill(stepper)) or placed[-1])
+    slow = load_scene(CONFIGS / "sls_finite_punch.yaml",
+                      overrides=["model.until=separation", "loading.v=1e-7"])
+    contact.run_level(slow, 16)
+    assert sum(placed) > 100, sum(placed)
+    placed.clear()
+    seed = load_scene(CONFIGS / "seed_flat_punch.yaml", overrides=["model.until=separation"])
+    contact.run_level(seed, 16)
+    assert placed and sum(placed) == 0
 
 
 def test_a_zone_alone_whose_first_fold_search_misses_retries_instead_of_bisecting(

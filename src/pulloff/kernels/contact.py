@@ -1284,22 +1284,66 @@ def _replayed_contact_modes(x, H, Hf, maxwell, V_inv, sc, prof, out):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def replay_elements(rows, kink, row_Hf, xs, lam, z, ctil, d, tau_arms, V_inv, maxwell, sc,
-                    prof, Y):
+def end_targets(xi, n, alpha, ends, dtheta, count, out):
+    """Where a receding zone end wants elements and has none: for each end ``b`` of
+    ``ends`` (the present one, the one predicted for the next step), ``b cos(k dtheta)`` for
+    ``k = 1..count`` inside ``(alpha, ends[0])``, unless one of the ``n`` sorted elements
+    ``xi`` (or a target already taken) lies within 0.4 of the angle spacing there. Fills
+    ``out`` (ascending) and returns how many. Compiled: it runs at every receding step, and
+    in numpy its few dozen tiny array operations cost a tenth of a step."""
+    taken = 0
+    for e in range(ends.size):
+        b = ends[e]
+        for k in range(1, count + 1):
+            th = k * dtheta
+            x = b * math.cos(th)
+            if not alpha < x < ends[0]:
+                continue
+            tol = 0.4 * b * max(math.sin(th) * dtheta, 0.5 * dtheta * dtheta)
+            lo, hi = 0, n  # (a bisection: numba's searchsorted costs microseconds a call)
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if xi[mid] < x:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            if lo > 0 and x - xi[lo - 1] <= tol or lo < n and xi[lo] - x <= tol:
+                continue
+            near = False
+            for j in range(taken):
+                if abs(out[j] - x) <= tol:
+                    near = True
+                    break
+            if not near:
+                out[taken] = x
+                taken += 1
+    out[:taken].sort()
+    return taken
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def replay_elements(rows, kink, row_Hf, first, xs, lam, z, ctil, d, tau_arms, V_inv, maxwell,
+                    sc, prof, Y):
     """``contact_replay.replay`` compiled: the modes (rows of ``Y``, zeroed) at the last row
-    of elements at ``xs``, each run from the first row through every step of ``rows`` (the
-    stepper's rows: t, H, alpha, beta, ...; ``kink[k]``: row ``k`` is an event's;
-    ``row_Hf[k]``: the arms' filtered lift there). False (``Y`` then meaningless) where one
-    of them joined the contact on the way: its memory of joining is not in the rows."""
+    of elements at ``xs``, each run from row ``first`` (at rest there if free: the caller
+    picks a row after which any earlier state has decayed below rounding) through every step
+    of ``rows`` (the stepper's rows: t, H, alpha, beta, ...; ``kink[k]``: row ``k`` is an
+    event's; ``row_Hf[k]``: the arms' filtered lift there). False (``Y`` then meaningless)
+    where one of them joined the contact on the way: its memory of joining is not in the
+    rows."""
     nm = lam.size
     n = xs.size
     Y[:, :] = 0.0
-    free = xs > rows[0, 2]
+    free = xs > rows[first, 2]
     w3 = np.zeros((max(nm, 1), 3))
     ap, bp, hp = np.empty(3), np.empty(3), np.empty(3)
     s0 = np.zeros(n)
     hf_c = np.empty(row_Hf.shape[1])
-    for k in range(1, rows.shape[0]):
+    # The free elements gathered for free_field (allocated once: this runs every step).
+    x_sel, s_sel, U_sel = np.empty(n), np.empty(n), np.empty(n)
+    Y_sel = np.empty((n, max(nm, 1)))
+    pick = np.empty(n, dtype=np.int64)
+    for k in range(first + 1, rows.shape[0]):
         t0, t1 = rows[k - 1, 0], rows[k, 0]
         dt = t1 - t0
         if dt <= 0.0:  # a jump: the contact lets go of what it no longer covers, at once
@@ -1338,19 +1382,22 @@ def replay_elements(rows, kink, row_Hf, xs, lam, z, ctil, d, tau_arms, V_inv, ma
             _replayed_contact_modes(xs[j], h_c, hf_c, maxwell, V_inv, sc, prof, Y[j])
             s0[j] = s_c
             free[j] = True
-        idx = np.nonzero(free)[0]
-        if idx.size and nm:
-            Yn = np.zeros((idx.size, nm))
-            U = np.zeros(idx.size)
-            Y0 = np.empty((idx.size, nm))
-            for i in range(idx.size):
+        if nm == 0:
+            continue
+        picked = 0
+        for j in range(n):
+            if free[j]:
+                pick[picked] = j
+                x_sel[picked], s_sel[picked] = xs[j], s0[j]
                 for m in range(nm):
-                    Y0[i, m] = Y[idx[i], m]
-            free_field(xs[idx], Y0, s0[idx], _ZERO, idx.size, bp[0], bp[1], bp[2], mus, z * dt,
-                       ctil, d, nm, w3, Yn, U)
-            for i in range(idx.size):
-                for m in range(nm):
-                    Y[idx[i], m] = Yn[i, m]
+                    Y_sel[picked, m] = Y[j, m]
+                picked += 1
+        # (free_field reads each element's modes before it writes them: in place is safe)
+        free_field(x_sel, Y_sel, s_sel, _ZERO, picked, bp[0], bp[1], bp[2], mus, z * dt,
+                   ctil, d, nm, w3, Y_sel, U_sel)
+        for i in range(picked):
+            for m in range(nm):
+                Y[pick[i], m] = Y_sel[i, m]
     for j in range(n):
         if not free[j]:
             return False

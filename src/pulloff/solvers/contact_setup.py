@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -45,6 +46,11 @@ class Law:
     @property
     def maxwell(self) -> bool:
         return self.kappa_arms.size > 0
+
+    @cached_property
+    def fastest_decay(self) -> float:
+        """The rate the fastest mode decays at [1 / time unit]; 0 without memory."""
+        return max(-float(np.min(self.lam)), 0.0)
 
     @property
     def kappa_instant(self) -> float:

@@ -113,6 +113,7 @@ class Stepper:
         self.per_zone = _NODES_PER_ZONE * math.sqrt(n / 64.0)
         self.rows = []
         self.row_Hf = []  # the arms' filtered lift at each row (a replay needs it)
+        self.row_arrays = None  # the rows as arrays, for replays (contact_replay._history)
         self.events = []  # (t, name)
         self.notes = []  # (what, t): why a run stopped early
         self.kinks = set()  # rows at events: the history may have a corner there
@@ -747,6 +748,7 @@ class Stepper:
                                  driver=self.now.driver + self._driver_rate() * step.dt)
         self._row(self.now)
         replay.refine(self)
+        replay.fill_receding_end(self)
         replay.thin(self)
         self._archive_behind()
 
