@@ -168,13 +168,20 @@ def fill_receding_end(stepper) -> int:
     nodes = stepper.nodes
     xs = np.empty(2 * count)
     xs = xs[:K.end_targets(nodes.xi, nodes.n, a, ends, dtheta, count, xs)]
+    return _place(stepper, xs)
+
+
+def _place(stepper, xs) -> int:
+    """Replay free elements at ``xs`` into the mesh now; how many (none where one of them
+    cannot be replayed)."""
     if xs.size == 0:
         return 0
     Y = replay(stepper, xs)
     if Y is None:
         return 0
+    nodes = stepper.nodes
     nodes.insert_many(xs, Y, np.full(xs.size, st.FREE), np.zeros((xs.size, nodes.D.shape[1])),
-                      np.zeros(xs.size), now.t)
+                      np.zeros(xs.size), stepper.now.t)
     return xs.size
 
 
@@ -194,14 +201,7 @@ def refine(stepper) -> int:
     want = now.beta * np.cos(theta_a * np.arange(1, 2 * MIN_INSIDE) / (2 * MIN_INSIDE))
     spacing = (now.beta - now.alpha) / (4 * MIN_INSIDE)
     xs = np.array([x for x in want if not nodes.near(float(x), spacing)])
-    if xs.size == 0:
-        return 0
-    Y = replay(stepper, xs)
-    if Y is None:
-        return 0
-    nodes.insert_many(xs, Y, np.full(xs.size, st.FREE), np.zeros((xs.size, nodes.D.shape[1])),
-                      np.zeros(xs.size), now.t)
-    return xs.size
+    return _place(stepper, xs)
 
 
 def thin(stepper) -> int:
