@@ -605,7 +605,8 @@ def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
         errors[n] = {name: abs(summary[name] / ref[name] - 1.0)
                      for name in ("t_separation", "F_peak_total")}
     sep = [errors[n]["t_separation"] for n in (16, 32, 64)]
-    assert sep[0] > 4.0 * sep[1] > 16.0 * sep[2], errors  # second order or better
+    # At least the order band's floor of tests/test_orders.py, 1.75 (2^1.75 = 3.36).
+    assert sep[0] > 3.36 * sep[1] > 11.3 * sep[2], errors
     assert sep[2] < 5e-7, errors
     peak = [errors[n]["F_peak_total"] for n in (16, 32, 64)]
     assert peak[0] > 4.0 * peak[1], errors
@@ -793,6 +794,10 @@ def test_a_replay_started_where_the_memory_has_decayed_is_the_whole_replay():
     assert scale > 0.0
     np.testing.assert_allclose(modes[first], modes[0], rtol=0.0, atol=1e-14 * scale)
     np.testing.assert_array_equal(contact_replay.replay(stepper, xs), modes[first])
+    # An element under the contact at that row would need its arms' memory of joining,
+    # which only a bond since t = 0 has: such a replay starts at the first row.
+    assert rows[first, 2] > 0.5 * now.alpha
+    assert contact_replay._forgotten_before(rows, law, np.array([0.5 * now.alpha])) == 0
 
 
 def test_elements_are_replayed_next_to_a_receding_end_only_where_its_memory_is_short(

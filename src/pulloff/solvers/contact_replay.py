@@ -91,10 +91,14 @@ def _forgotten_before(rows, law, xs) -> int:
     only for a bond since ``t = 0``). A standard linear solid pulled at 1e-7 m/s skips half
     of its rows."""
     slowest = -float(np.max(law.lam))  # (lam < 0: the modes' decay rates)
-    if not slowest > 0.0:
-        return 0
+    if not slowest > 1e-12 * law.fastest_decay:
+        return 0  # (a Maxwell fluid's zero mode comes out of the eigensolver as ~ -1e-14)
     t_forget = rows[-1, 0] - FORGET_EFOLDS / slowest
-    first = max(int(np.searchsorted(rows[:, 0], t_forget, side="right")) - 1, 0)
+    # At least the last step is replayed: a memory shorter than the clock's rounding would
+    # otherwise leave the elements at rest.
+    first = min(int(np.searchsorted(rows[:, 0], t_forget, side="right")) - 1,
+                rows.shape[0] - 2)
+    first = max(first, 0)
     if law.maxwell and np.any(xs <= rows[first, 2]):
         return 0
     return first
