@@ -583,6 +583,22 @@ def test_finite_punch_behind_a_spring_reaches_its_strength_limit(material):
         assert res.t_detach == pytest.approx(ref["t_onset"], rel=1e-4)
 
 
+def test_a_slow_kelvin_voigt_pulls_onset_converges_to_the_onset_solvers():
+    """separation_kv.yaml at 1e-7 m/s: a 97 s pull against a 1 ms memory. Four elements
+    entered per step across an advancing end whose displacement turns over within a
+    hundredth of their spacing, and the moving-edge onset stalled 3.2e-5, 2.8e-5, 2.4e-5
+    late at n = 16, 32, 64. The entering elements now resolve the memory's angle
+    (Stepper._memory_entries): measured 6.4e-6, -7.6e-7, -2.0e-7 against the seed's onset
+    solver (rtol 1e-8, itself 3.5e-9)."""
+    base = load_scene(CONFIGS / "separation_kv.yaml", overrides=["loading.v=1e-7"])
+    exact = solvers.simulate(override(base, ["model.until=detach", "numerics.rtol=1e-8"]))
+    assert exact.error_estimate < 1e-8
+    scene = override(base, ["model.until=separation"])
+    errors = [abs(contact.run_level(scene, n).summary["t_detach"] / exact.t_detach - 1.0)
+              for n in (16, 32, 64)]
+    assert errors[1] < 3e-6 and errors[2] < 1e-6, errors
+
+
 def test_a_slow_standard_linear_solid_crack_is_resolved_from_its_onset():
     """sls_finite_punch.yaml at 1e-7 m/s (the rate sweep's relaxed end): an elastic crack
     would run at once at the onset; the dashpot makes it grow about exponentially from it

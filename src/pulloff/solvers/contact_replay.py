@@ -134,6 +134,13 @@ END_SPACING = 2.0
 END_REACH = 1.5
 
 
+def memory_angle(law, speed: float, beta: float) -> float:
+    """The angle ``sqrt(2 d / beta)`` next to a zone end moving at ``speed`` over which its
+    fastest mode remembers it (``d = speed / decay``, the distance the end travels in that
+    memory): the displacement varies on this scale there. Dimensionless."""
+    return math.sqrt(2.0 * abs(speed) / (law.fastest_decay * beta))
+
+
 def fill_receding_end(stepper) -> int:
     """Replay elements evenly in angle next to a receding zone end; returns how many.
 
@@ -161,8 +168,7 @@ def fill_receding_end(stepper) -> int:
     b, a = now.beta, max(now.alpha, 0.0)
     theta_zone = (math.atan2(math.sqrt(max((b - a) * (b + a), 0.0)), a) if a > 0.0
                   else 0.5 * math.pi)
-    speed = (before.beta - b) / (now.t - before.t)
-    theta_memory = math.sqrt(2.0 * speed / (law.fastest_decay * b))
+    theta_memory = memory_angle(law, (before.beta - b) / (now.t - before.t), b)
     dtheta = theta_memory * END_SPACING / stepper.per_zone
     reach = min(END_REACH * theta_memory, theta_zone)
     if not dtheta > 0.0 or reach < dtheta:
