@@ -264,7 +264,9 @@ class Stepper:
         2.1e-5 to below 1.4e-6. The cap: 4 gave the slow pull 2-100x less error but took
         compliant_machine behind 1 N/m from 16 s to 35 s at rtol 1e-3 (20 s now; unthinned
         behind a spring, its entering elements stay), 1 took the one behind 10 N/m to 14 s
-        (a bisection; 3.8 s now, 12 s before)."""
+        (a bisection; 3.8 s now, 12 s before). Those times hinge on whether a level falls
+        into the bisection after a lost balance, which flips with small changes of state
+        (README, Known issues)."""
         law = self.setup.law
         if not self.setup.flat or law.fastest_decay == 0.0 or speed <= 0.0:
             return 0
