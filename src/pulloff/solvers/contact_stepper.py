@@ -249,28 +249,34 @@ class Stepper:
             zone = math.atan2(math.sqrt(max((now.beta - now.alpha) * (now.beta + now.alpha), 0.0)),
                               now.alpha) if now.alpha > 0.0 else 0.5 * math.pi
             step.k_beta = max(ENTRY_NODES, int(math.ceil(self.per_zone * swept / max(zone, 1e-300))),
-                              self._memory_entries(swept, grow_b / dt))
+                              self._memory_entries(start))
         return step
 
-    def _memory_entries(self, swept, speed) -> int:
+    def _memory_entries(self, start) -> int:
         """Entering elements that resolve the advancing end's memory: the angle its fastest
         mode spans (``contact_replay.memory_angle``) in steps of ``END_SPACING / per_zone``,
-        as next to a receding end; at most ``ENTRY_CAP per_zone``. A slow Kelvin-Voigt pull
+        as next to a receding end, over the stretch beyond ``start``; at most ``ENTRY_CAP
+        per_zone``. A slow Kelvin-Voigt pull
         (separation_kv at 1e-7 m/s: a 97 s pull against a 1 ms memory) entered 4 elements a
         step across an end whose displacement turns over within a hundredth of their spacing:
         its onset was 3.2e-5, 2.8e-5, 2.4e-5, 3.4e-6 late at n = 16..128 (not converging);
         now 6.4e-6, -7.6e-7, -2.0e-7, -1.2e-9 against the onset solver. Behind 1 and 10 N/m
         (compliant_machine) the onset force's error at rtol 1e-3 fell from 1.1e-5 and
-        2.1e-5 to below 1.4e-6. The cap: 4 gave the slow pull 2-100x less error but took
+        2.1e-5 to below 1.6e-6. The cap: 4 gave the slow pull 2-100x less error but took
         compliant_machine behind 1 N/m from 16 s to 35 s at rtol 1e-3 (20 s now; unthinned
         behind a spring, its entering elements stay), 1 took the one behind 10 N/m to 14 s
         (a bisection; 3.8 s now, 12 s before). Those times hinge on whether a level falls
         into the bisection after a lost balance, which flips with small changes of state
         (README, Known issues)."""
-        law = self.setup.law
-        if not self.setup.flat or law.fastest_decay == 0.0 or speed <= 0.0:
+        law, now, before = self.setup.law, self.now, self.before
+        if not self.setup.flat or law.fastest_decay == 0.0:
             return 0
-        theta = replay.memory_angle(law, speed, self.now.beta)
+        # One count for every trial of the step, from the last step's motion: the longest a
+        # step may be (twice the last) sweeps this angle. (Counted from each trial's own
+        # length it jumped with the trial, and an event's residual with it, by ~6e-8.)
+        grown = now.beta - before.beta
+        swept = math.acos(min(start / (now.beta + 2.0 * grown), 1.0))
+        theta = replay.memory_angle(law, grown / (now.t - before.t), now.beta)
         want = self.per_zone * swept / (replay.END_SPACING * theta)
         return int(math.ceil(min(want, ENTRY_CAP * self.per_zone)))
 
