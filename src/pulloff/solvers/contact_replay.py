@@ -90,10 +90,9 @@ def _forgotten_before(rows, law, xs) -> int:
     Maxwell arms where one of them is in contact there (its arms' memory of joining is known
     only for a bond since ``t = 0``). A standard linear solid pulled at 1e-7 m/s skips half
     of its rows."""
-    slowest = -float(np.max(law.lam))  # (lam < 0: the modes' decay rates)
-    if not slowest > 1e-12 * law.fastest_decay:
-        return 0  # (a Maxwell fluid's zero mode comes out of the eigensolver as ~ -1e-14)
-    t_forget = rows[-1, 0] - FORGET_EFOLDS / slowest
+    if law.slowest_decay == 0.0:
+        return 0
+    t_forget = rows[-1, 0] - FORGET_EFOLDS / law.slowest_decay
     # At least the last step is replayed: a memory shorter than the clock's rounding would
     # otherwise leave the elements at rest.
     first = min(int(np.searchsorted(rows[:, 0], t_forget, side="right")) - 1,
@@ -134,6 +133,14 @@ END_SPACING = 2.0
 END_REACH = 1.5
 
 
+def zone_angle(alpha: float, beta: float) -> float:
+    """The angle ``acos(alpha / beta)`` the zone spans in the gap's variable (``pi / 2``
+    without a contact), without cancellation near ``alpha = beta``."""
+    if alpha <= 0.0:
+        return 0.5 * math.pi
+    return math.atan2(math.sqrt(max((beta - alpha) * (beta + alpha), 0.0)), alpha)
+
+
 def memory_angle(law, speed: float, beta: float) -> float:
     """The angle ``sqrt(2 d / beta)`` next to a zone end moving at ``speed`` over which its
     fastest mode remembers it (``d = speed / decay``, the distance the end travels in that
@@ -166,8 +173,7 @@ def fill_receding_end(stepper) -> int:
             or not 0.0 < now.beta < before.beta or law.fastest_decay == 0.0):
         return 0
     b, a = now.beta, max(now.alpha, 0.0)
-    theta_zone = (math.atan2(math.sqrt(max((b - a) * (b + a), 0.0)), a) if a > 0.0
-                  else 0.5 * math.pi)
+    theta_zone = zone_angle(a, b)
     theta_memory = memory_angle(law, (before.beta - b) / (now.t - before.t), b)
     dtheta = theta_memory * END_SPACING / stepper.per_zone
     reach = min(END_REACH * theta_memory, theta_zone)
@@ -206,8 +212,7 @@ def refine(stepper) -> int:
     # (the elements strictly inside, counted on the sorted mesh: this runs every step)
     if nodes.below(now.beta) - nodes.at_most(now.alpha) >= MIN_INSIDE:
         return 0
-    theta_a = math.atan2(math.sqrt(max((now.beta - now.alpha) * (now.beta + now.alpha), 0.0)),
-                         now.alpha)
+    theta_a = zone_angle(now.alpha, now.beta)
     want = now.beta * np.cos(theta_a * np.arange(1, 2 * MIN_INSIDE) / (2 * MIN_INSIDE))
     spacing = (now.beta - now.alpha) / (4 * MIN_INSIDE)
     xs = np.array([x for x in want if not nodes.near(float(x), spacing)])
@@ -233,8 +238,7 @@ def thin(stepper) -> int:
     budget = int(2 * factor * stepper.per_zone)
     if idx.size <= budget:
         return 0
-    theta_zone = math.atan2(math.sqrt((now.beta - now.alpha) * (now.beta + now.alpha)),
-                            now.alpha) if now.alpha > 0.0 else 0.5 * math.pi
+    theta_zone = zone_angle(now.alpha, now.beta)
     spacing = theta_zone / (factor * stepper.per_zone)
     x = nodes.xi[idx]  # the angle acos(x/b) without cancellation near b, as K.angle
     theta = np.arctan2(np.sqrt(np.maximum((now.beta - x) * (now.beta + x), 0.0)), x)

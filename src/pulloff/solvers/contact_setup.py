@@ -52,6 +52,13 @@ class Law:
         """The rate the fastest mode decays at [1 / time unit]; 0 without memory."""
         return max(-float(np.min(self.lam)), 0.0)
 
+    @cached_property
+    def slowest_decay(self) -> float:
+        """The rate the slowest mode decays at [1 / time unit]; 0 where one never decays (a
+        Maxwell fluid's zero mode comes out of the eigensolver as ~ -1e-14)."""
+        slowest = -float(np.max(self.lam))
+        return slowest if slowest > 1e-12 * self.fastest_decay else 0.0
+
     @property
     def kappa_instant(self) -> float:
         return self.kappa_inf + float(np.sum(self.kappa_arms))

@@ -246,8 +246,7 @@ class Stepper:
             beta_next = now.beta + grow_b
             start = max(now.beta, self.nodes.xi_max, 0.0)
             swept = math.acos(min(start / beta_next, 1.0))
-            zone = math.atan2(math.sqrt(max((now.beta - now.alpha) * (now.beta + now.alpha), 0.0)),
-                              now.alpha) if now.alpha > 0.0 else 0.5 * math.pi
+            zone = replay.zone_angle(now.alpha, now.beta)
             step.k_beta = max(ENTRY_NODES, int(math.ceil(self.per_zone * swept / max(zone, 1e-300))),
                               self._memory_entries(start))
         return step
