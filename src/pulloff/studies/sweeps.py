@@ -217,7 +217,12 @@ def run_point(base_yaml: str, overrides: Sequence[str], history: bool = False,
         data = read_yaml(base_yaml)
         for name in drop_adhesion:
             data["adhesion"].pop(name, None)
-        res = solvers.simulate(parse_scene(data, overrides=overrides))
+        scene = parse_scene(data, overrides=overrides)
+        # A row without its history keeps only the summary: the run's SI history is then
+        # its first and last row, not the hundreds a stored one has (measured: 88 us of a
+        # seed scene's ~2 ms at rtol 1e-6 for 300 rows, 46 us for two).
+        observers = None if history else solvers.Observers(history_rows=2)
+        res = solvers.simulate(scene, observers=observers)
     except Exception as exc:  # a failed scene is data, not the end of the sweep
         row.update(status="failed", message=f"{type(exc).__name__}: {exc}")
         return row
