@@ -543,3 +543,69 @@ def test_property_a_receding_ends_targets_are_new_spaced_and_inside(old, alpha, 
                     and all(abs(x - y) > tol for y in expected)):
                 expected.append(x)
     np.testing.assert_array_equal(out[:taken], np.sort(expected))
+
+
+def _scanned_memory(xi, status, D, tj, kappa, tau, t, x):
+    """The contact memory at ``x`` as it was found before the contact view: a scan of every
+    element up to the first contact element beyond ``x``."""
+    left = right = -1
+    for j in range(xi.size):
+        if status[j] != 1:
+            continue
+        if xi[j] <= x:
+            left = j
+        else:
+            right = j
+            break
+    out = np.zeros(tau.size)
+    for i in range(tau.size):
+        vl = D[left, i] * math.exp(-(t - tj[left]) / tau[i]) if left >= 0 else 0.0
+        vr = D[right, i] * math.exp(-(t - tj[right]) / tau[i]) if right >= 0 else 0.0
+        if left >= 0 and right >= 0 and xi[right] > xi[left]:
+            w = (x - xi[left]) / (xi[right] - xi[left])
+            out[i] = (1.0 - w) * vl + w * vr
+        else:
+            out[i] = vl if left >= 0 else vr
+    return out
+
+
+@settings(max_examples=80, deadline=None)
+@given(data=st.data(), n=st.integers(0, 30), n_arms=st.integers(1, 3))
+def test_property_the_contact_view_is_a_scan_of_every_element(data, n, n_arms):
+    """kernels.contact.contact_view and _memory with it (a step's contact elements gathered
+    once, then bisected) against a scan of every element: the same neighbours and values, bit
+    for bit, repeated and tied positions, no contact element, and points beyond them all
+    included; its running sums are the trapezoid from the centre."""
+    from pulloff.kernels import contact as C
+
+    xs = data.draw(st.lists(st.sampled_from([0.0, 0.25, 0.5, 0.75, 1.0, 1.5]) | st.floats(0.0, 2.0),
+                            min_size=n, max_size=n))
+    xi = np.sort(np.array(xs, dtype=float))
+    status = np.array(data.draw(st.lists(st.sampled_from([0, 1, 2]), min_size=n, max_size=n)),
+                      dtype=np.int64)
+    D = np.array(data.draw(st.lists(st.floats(-2.0, 2.0), min_size=n * n_arms,
+                                    max_size=n * n_arms)), dtype=float).reshape(n, n_arms)
+    tj = np.array(data.draw(st.lists(st.floats(0.0, 1.0), min_size=n, max_size=n)), dtype=float)
+    kappa = np.linspace(1.0, 2.0, n_arms)
+    tau = np.linspace(0.3, 3.0, n_arms)
+    sc = np.zeros(C.S_N)
+    sc[C.S_T0], sc[C.S_DT] = 1.0, 0.25
+    t1 = sc[C.S_T0] + sc[C.S_DT]
+    idx, acc = C.contact_view(xi, status, D, tj, n, kappa, tau, sc)
+    assert idx.tolist() == [j for j in range(n) if status[j] == 1]
+    total, x_prev, v_prev = 0.0, 0.0, math.nan
+    for k, j in enumerate(idx.tolist()):
+        v = 0.0
+        for i in range(n_arms):
+            v += kappa[i] * D[j, i] * math.exp(-(t1 - tj[j]) / tau[i])
+        total += v * xi[j] if math.isnan(v_prev) else 0.5 * (v + v_prev) * (xi[j] - x_prev)
+        x_prev, v_prev = xi[j], v
+        assert acc[0, k] == v and acc[1, k] == total
+    points = list(xi) + [-0.5, 0.6, 2.5] + data.draw(st.lists(st.floats(0.0, 2.0), max_size=5))
+    out = np.empty(n_arms)
+    for x in points:
+        for t in (t1, 0.5):
+            got = C._memory(xi, status, D, tj, n, kappa, tau, t, float(x), out, idx)
+            want = _scanned_memory(xi, status, D, tj, kappa, tau, t, float(x))
+            assert out.tolist() == want.tolist(), (x, t)
+            assert got == sum(kappa[i] * want[i] for i in range(n_arms))

@@ -79,6 +79,10 @@ def step_constants(setup) -> np.ndarray:
     return sc
 
 
+#: The contact view of a law without arms (never read).
+_NO_CONTACTS = (np.zeros(0, dtype=np.int64), np.zeros((2, 0)))
+
+
 class Step:
     """A trial step of length ``dt`` from ``now``; ``before`` is the instant one step earlier
     on the same smooth stretch (None after an event)."""
@@ -112,11 +116,28 @@ class Step:
         # root they end on): a step answers those from its memo.
         self._memo = {}
         self.fresh = stepper.fresh
+        self._contacts = None  # (view, element count): see `contacts`
         sc = stepper.step_constants.copy()
         sc[K.S_T0], sc[K.S_DT], sc[K.S_ALPHA0], sc[K.S_BETA0] = now.t, dt, now.alpha, now.beta
         sc[K.S_XIMAX], sc[K.S_KINK] = stepper.nodes.xi_max, stepper.first_edge
         sc[K.S_LIVE_END] = stepper.nodes.live_end
         self._constants = sc
+
+    @property
+    def contacts(self):
+        """The contact elements and their memory at the step's end
+        (:func:`pulloff.kernels.contact.contact_view`), gathered once per step (again where
+        archived elements came back): every trial reads them."""
+        nodes = self.s.nodes
+        if self._contacts is None or self._contacts[1] != nodes.n:
+            if self.s.setup.law.maxwell:
+                law = self.s.setup.law
+                view = K.contact_view(nodes.xi, nodes.status, nodes.D, nodes.tj, nodes.n,
+                                      law.kappa_arms, law.tau_arms, self._constants)
+            else:  # no arms, no memory: never read
+                view = _NO_CONTACTS
+            self._contacts = (view, nodes.n)
+        return self._contacts[0]
 
     @property
     def edges(self) -> np.ndarray:
@@ -193,7 +214,7 @@ class Step:
             return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
                     - memory)
         if law.maxwell:
-            memory = self.s.contact_memory(xi, self.now.t + self.dt)
+            memory = self.s.contact_memory(xi, self.now.t + self.dt, self.contacts[0])
             arms = 0.0
             for kappa, lag in zip(law.kappa_arms.tolist(), (H_new - Hf).tolist()):
                 arms += kappa * lag  # in order, as the compiled edge search sums them
@@ -222,7 +243,8 @@ class Step:
         if not law.maxwell:
             return np.array([h0 + s_c * (h1 + s_c * h2) + G])
         t = self.now.t + s_c * self.dt
-        E = self.filtered_lift(H_new, s_c) + G + self.s.contact_memory_arms(x, t)
+        E = self.filtered_lift(H_new, s_c) + G + self.s.contact_memory_arms(x, t,
+                                                                           self.contacts[0])
         return law.V_inv @ E
 
     def compiled_secant(self, H_new, alpha=None):
@@ -242,8 +264,7 @@ class Step:
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         edges = self.edges
-        stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf,
-                 Hf if law.maxwell else now.Hf)
+        Hf1 = Hf if law.maxwell else now.Hf
         table = s.setup.indenter.table
         held = math.nan if alpha is None else float(alpha)
 
@@ -251,6 +272,8 @@ class Step:
             # (the mesh as it is now: a Python evaluation may have brought archived elements
             # back since)
             mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf1,
+                     *self.contacts)
             sc[K.S_LIVE_END] = nodes.live_end
             x, last = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh,
                                     self.law, stepw, table, sc, edges, lift, nodes.n)
@@ -296,8 +319,9 @@ class Step:
             Hf = now.Hf
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
-        stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf)
         while True:
+            stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf,
+                     *self.contacts)
             mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
             _, lo, hi, m, out, res = K.trial_state(alpha, beta, mesh, self.law, stepw,
                                                    s.setup.indenter.table, sc, self.edges,

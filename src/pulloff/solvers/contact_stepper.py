@@ -198,23 +198,24 @@ class Stepper:
             self.nodes.Y[:self.nodes.n] = 0.0
 
     # --- evaluation details the step needs -----------------------------------------------
-    def contact_memory_arms(self, xi, t):
+    def contact_memory_arms(self, xi, t, contacts):
         """``D_i e^{-(t - tj)/tau_i}`` of a contact element at ``xi`` (a Maxwell solid), arm by
         arm: what its dashpots remember of how it joined (``E_i = Hf_i + g + this``),
-        interpolated between contact elements; 0 where none joined by contact (a flat punch
-        bonded from the start)."""
+        interpolated between the contact elements ``contacts`` (their indices, the step's
+        ``Step.contacts``); 0 where none joined by contact (a flat punch bonded from the
+        start)."""
         nodes = self.nodes
         law = self.setup.law
         out = np.empty(law.tau_arms.size)
         K._memory(nodes.xi, nodes.status, nodes.D, nodes.tj, nodes.n, law.kappa_arms,
-                  law.tau_arms, t, xi, out)
+                  law.tau_arms, t, xi, out, contacts)
         return out
 
-    def contact_memory(self, xi, t):
+    def contact_memory(self, xi, t, contacts):
         """``sum_i kappa_i D_i e^{-(t - tj)/tau_i}``: the arms' memory in the contact load."""
         nodes, law = self.nodes, self.setup.law
         return K._memory(nodes.xi, nodes.status, nodes.D, nodes.tj, nodes.n, law.kappa_arms,
-                         law.tau_arms, t, xi, self._arms_scratch)
+                         law.tau_arms, t, xi, self._arms_scratch, contacts)
 
     # --- history ---------------------------------------------------------------------------
     def _row(self, now):
