@@ -575,7 +575,8 @@ def test_property_the_contact_view_is_a_scan_of_every_element(data, n, n_arms):
     """kernels.contact.contact_view and _memory with it (a step's contact elements gathered
     once, then bisected) against a scan of every element: the same neighbours and values, bit
     for bit, repeated and tied positions, no contact element, and points beyond them all
-    included; its running sums are the trapezoid from the centre."""
+    included; its running sums are the trapezoid from the centre. And _free_modes (a smooth
+    edge beyond the contact meets a free element) against np.interp over the free ones."""
     from pulloff.kernels import contact as C
 
     xs = data.draw(st.lists(st.sampled_from([0.0, 0.25, 0.5, 0.75, 1.0, 1.5]) | st.floats(0.0, 2.0),
@@ -591,8 +592,9 @@ def test_property_the_contact_view_is_a_scan_of_every_element(data, n, n_arms):
     sc = np.zeros(C.S_N)
     sc[C.S_T0], sc[C.S_DT] = 1.0, 0.25
     t1 = sc[C.S_T0] + sc[C.S_DT]
-    idx, acc = C.contact_view(xi, status, D, tj, n, kappa, tau, sc)
+    idx, acc, first_free = C.contact_view(xi, status, D, tj, n, kappa, tau, sc)
     assert idx.tolist() == [j for j in range(n) if status[j] == 1]
+    assert first_free.tolist() == [min([j for j in range(n) if status[j] == 0] + [n])]
     total, x_prev, v_prev = 0.0, 0.0, math.nan
     for k, j in enumerate(idx.tolist()):
         v = 0.0
@@ -603,6 +605,18 @@ def test_property_the_contact_view_is_a_scan_of_every_element(data, n, n_arms):
         assert acc[0, k] == v and acc[1, k] == total
     points = list(xi) + [-0.5, 0.6, 2.5] + data.draw(st.lists(st.floats(0.0, 2.0), max_size=5))
     out = np.empty(n_arms)
+    # The free elements' modes (here D's columns) at x, as np.interp between them gives them
+    # (the nearest below them all, zero beyond), found from the bisection outward.
+    free = [j for j in range(n) if status[j] == 0]
+    unique = len({xi[j] for j in free}) == len(free)
+    for x in points:
+        C._free_modes(float(x), xi, D, status, n, int(first_free[0]), out)
+        if not free or x > xi[free[-1]]:
+            want = [0.0] * n_arms
+        else:
+            want = [float(np.interp(x, xi[free], D[free, i])) for i in range(n_arms)]
+        if unique:  # (np.interp between tied nodes is its own convention)
+            assert out.tolist() == want, (x, free)
     for x in points:
         for t in (t1, 0.5):
             got = C._memory(xi, status, D, tj, n, kappa, tau, t, float(x), out, idx)

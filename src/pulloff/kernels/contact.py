@@ -583,8 +583,9 @@ def _split_integral(th, f, m, s, th_kink):
 R_GAP, R_EDGE_LOAD, R_F_CONTACT, R_F_TOTAL, R_CENTRE_U, R_N = range(6)
 #: Indices of the step constants ``sc`` of :func:`evaluate_step`.
 #: ``S_LIVE_END``: the nearest archived element (inf: none; see ``contact_state.Nodes``).
+#: ``S_JUMP``: 1.0 in a zero-time transition (``Step.jump``: the dashpots do not move).
 (S_T0, S_DT, S_ALPHA0, S_BETA0, S_H1, S_HDOT, S_XIMAX, S_KAPPA, S_C, S_D, S_FLAT, S_AF, S_C_G,
- S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH, S_KINK, S_LIVE_END, S_N) = range(20)
+ S_N_G, S_K_ALPHA, S_K_BETA, S_FRESH, S_KINK, S_LIVE_END, S_JUMP, S_N) = range(21)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -662,19 +663,24 @@ def _profile(sc, x, prof):
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def contact_view(xi, status, D, tj, n_all, kappa_arms, tau_arms, sc):
-    """The contact elements of a mesh, once per step: ``(idx, acc)``, their indices in
-    ascending ``x``, and at the step's end ``t1`` each one's memory in the contact load
-    ``v = sum_i kappa_i D_i e^{-(t1 - tj)/tau_i}`` (``acc[0]``) and the trapezoid of ``v``
-    from the centre to it (``acc[1]``), summed as :func:`_memory_integral` sums them.
+    """The contact elements of a mesh, once per step: ``(idx, acc, first_free)``, their
+    indices in ascending ``x``, and at the step's end ``t1`` each one's memory in the contact
+    load ``v = sum_i kappa_i D_i e^{-(t1 - tj)/tau_i}`` (``acc[0]``) and the trapezoid of
+    ``v`` from the centre to it (``acc[1]``), summed as :func:`_memory_integral` sums them;
+    and the index of the first free element (``n_all``: none), below which
+    :func:`_free_modes` looks no further.
 
     A smooth indenter's contact holds thousands of elements after a slow approach, and every
     trial scanned them all, twice or more (the memory at the edge, and its integral with an
     exponential per element and arm): a standard linear solid's sphere retracted at 1e-8 m/s
     spent most of its time there."""
     nc = 0
+    first_free = n_all
     for j in range(n_all):
         if status[j] == 1:
             nc += 1
+        elif status[j] == 0 and first_free == n_all:
+            first_free = j
     idx = np.empty(nc, dtype=np.int64)
     acc = np.empty((2, nc))
     t1 = sc[S_T0] + sc[S_DT]
@@ -696,7 +702,7 @@ def contact_view(xi, status, D, tj, n_all, kappa_arms, tau_arms, sc):
         acc[0, k] = v
         acc[1, k] = total
         k += 1
-    return idx, acc
+    return idx, acc, np.array([first_free])
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
@@ -777,8 +783,8 @@ def _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out
     enters virgin solid. Each is advanced from where its free stretch starts; returns the
     count. ``flag``: 0 an existing element, 1 a new one, 2 one that stays in contact."""
     xi, Y, status, D, tj, t_last = mesh
-    ctil, kappa_arms, tau_arms, V_inv = law
-    mus, decay, zdt, w3, arm_mus, Hf0, Hf1, idx, acc = stepw
+    ctil, kappa_arms, tau_arms, V_inv, V = law
+    mus, decay, zdt, w3, arm_mus, Hf0, Hf1, idx, acc, first_free = stepw
     xo, Yo, Uo, fo = out
     nm = mus.size
     ap, bp, hp = paths[0], paths[1], paths[2]
@@ -901,8 +907,8 @@ def evaluate_step(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, pro
     load of the contact element at ``a``, the forces
     and the centre's displacement. Returns the element count written to ``out``."""
     xi, Y, status, D, tj, t_last = mesh
-    ctil, kappa_arms, tau_arms, V_inv = law
-    mus, decay, zdt, w3, arm_mus, Hf0, Hf1, idx, acc = stepw
+    ctil, kappa_arms, tau_arms, V_inv, V = law
+    mus, decay, zdt, w3, arm_mus, Hf0, Hf1, idx, acc, first_free = stepw
     xo, Yo, Uo, fo = out
     m = _gather(mesh, law, stepw, paths, sc, lo, hi, alpha1, beta1, n_all, prof, out)
     integral = _gap_and_edge(xo, Uo, fo, m, alpha1, beta1, sc, prof, res)
@@ -1045,36 +1051,109 @@ def trial_state(alpha, beta, mesh, law, stepw, prof, sc0, edges, lift, n_all):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def flat_edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
-    """The zone end the edge condition puts with a flat punch's edge at ``alpha``, as
-    ``contact_phases.edge_zone`` computes it (the same sums, in the same order)."""
+def edge_load(alpha, mesh, law, stepw, prof, sc0, n_all):
+    """The line load of a contact element at ``alpha`` at the end of the step, as
+    ``contact_step.Step.contact_load`` gives it (the same sums in the same order: that calls
+    this for a smooth indenter on a solid with arms). With arms, a smooth edge beyond where it
+    was (or any edge in a jump, ``sc0[S_JUMP]``) meets a free element: its dashpots where the
+    free side left them (``stepw``'s free elements at the step's start, interpolated),
+    relaxing toward the indenter over the step, or held in a jump (the glassy modulus)."""
     xi, Y, status, D, tj, t_last = mesh
-    ctil, kappa_arms, tau_arms, V_inv = law
-    Hf1, idx = stepw[6], stepw[7]
+    ctil, kappa_arms, tau_arms, V_inv, V = law
     H1 = sc0[S_H1]
-    load = sc0[S_KAPPA] * (H1 + _profile(sc0, alpha, prof))
+    G = _profile(sc0, alpha, prof)
     na = tau_arms.size
-    if na > 0:
+    if na == 0:
+        return sc0[S_KAPPA] * (H1 + G) + sc0[S_C] * sc0[S_HDOT]
+    Hf0, Hf1, idx, first_free = stepw[5], stepw[6], stepw[7], stepw[9]
+    if sc0[S_FLAT] == 0.0 and (sc0[S_JUMP] > 0.0 or alpha > sc0[S_ALPHA0]):
+        nm = V.shape[1]
+        modes = np.zeros(nm)
+        _free_modes(alpha, xi, Y, status, n_all, first_free[0], modes)
+        if sc0[S_JUMP] > 0.0:
+            instant = sc0[S_KAPPA]
+            held = 0.0
+            for i in range(na):
+                instant += kappa_arms[i]
+                E = 0.0
+                for k in range(nm):
+                    E += V[i, k] * modes[k]
+                held += kappa_arms[i] * E
+            return instant * (H1 + G) - held
+        memory = 0.0
         arms = 0.0
         for i in range(na):
+            E = 0.0
+            for k in range(nm):
+                E += V[i, k] * modes[k]
+            memory += kappa_arms[i] * (E - Hf0[i] - G) * math.exp(-sc0[S_DT] / tau_arms[i])
             arms += kappa_arms[i] * (H1 - Hf1[i])
-        mem = np.empty(na)
-        t1 = sc0[S_T0] + sc0[S_DT]
-        load = load + arms - _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1,
-                                     alpha, mem, idx)
-    else:
-        load = load + sc0[S_C] * sc0[S_HDOT]
-    q = max(load, 0.0)
+        return sc0[S_KAPPA] * (H1 + G) + arms - memory
+    arms = 0.0
+    for i in range(na):
+        arms += kappa_arms[i] * (H1 - Hf1[i])
+    mem = np.empty(na)
+    t1 = sc0[S_T0] + sc0[S_DT]
+    load = sc0[S_KAPPA] * (H1 + G)
+    return load + arms - _memory(xi, status, D, tj, n_all, kappa_arms, tau_arms, t1, alpha,
+                                 mem, idx)
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _free_modes(x, xi, Y, status, n_all, first_free, out):
+    """Modes of a free element at ``x`` (into ``out``): linear between the free elements
+    around it (as ``np.interp`` between them), the nearest one's below them all, zero beyond
+    them all (virgin solid). From the bisection of the mesh outward to the nearest free
+    element each side: beyond a smooth edge they lie next to it (a slow approach leaves
+    thousands of contact elements below it: the search down stops at the first free
+    element, ``first_free``)."""
+    lo, hi = 0, n_all
+    while lo < hi:  # elements at or below x: [0, lo)
+        mid = (lo + hi) // 2
+        if xi[mid] <= x:
+            lo = mid + 1
+        else:
+            hi = mid
+    left = lo - 1
+    while left >= first_free and status[left] != 0:
+        left -= 1
+    if left < first_free:
+        left = -1
+    right = lo
+    while right < n_all and status[right] != 0:
+        right += 1
+    for k in range(out.size):
+        out[k] = 0.0
+    if right >= n_all:  # beyond every free element: virgin, unless x is the last one
+        if left >= 0 and xi[left] == x:
+            for k in range(out.size):
+                out[k] = Y[left, k]
+        return
+    if left < 0 or xi[left] == x:
+        j = right if left < 0 else left
+        for k in range(out.size):
+            out[k] = Y[j, k]
+        return
+    for k in range(out.size):
+        slope = (Y[right, k] - Y[left, k]) / (xi[right] - xi[left])
+        out[k] = slope * (x - xi[left]) + Y[left, k]
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def edge_zone(alpha, mesh, law, stepw, prof, sc0, n_all):
+    """The zone end the edge condition puts with the edge at ``alpha``, as
+    ``contact_phases.edge_zone`` computes it."""
+    q = max(edge_load(alpha, mesh, law, stepw, prof, sc0, n_all), 0.0)
     return math.sqrt(alpha * alpha + q * q)  # (numba's hypot rounds otherwise)
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _trial_edges(x, alpha, mesh, law, stepw, prof, sc0, n_all):
-    """The edges a phase's secant tries at ``x``: a flat punch's receding edge at ``x`` with
-    the zone end from the edge condition (``alpha`` nan), or the zone end at ``x`` with the
-    edge held at ``alpha``."""
+    """The edges a phase's secant tries at ``x``: the edge at ``x`` with the zone end from the
+    edge condition (``alpha`` nan), or the zone end at ``x`` with the edge held at
+    ``alpha``."""
     if math.isnan(alpha):
-        return x, flat_edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
+        return x, edge_zone(x, mesh, law, stepw, prof, sc0, n_all)
     return alpha, x
 
 

@@ -175,7 +175,7 @@ def _Hf(step, H):
 def edge_zone(step, H, alpha):
     """The zone end the edge condition puts with the edge at ``alpha``."""
     Q = max(step.contact_load(alpha, H, step.lift_rate(H), _Hf(step, H)), 0.0)
-    return math.sqrt(alpha * alpha + Q * Q)  # (kernels.contact.flat_edge_zone: the same sum)
+    return math.sqrt(alpha * alpha + Q * Q)  # (kernels.contact.edge_zone: the same sum)
 
 
 def receding(step, H, guess_alpha):
@@ -256,7 +256,7 @@ def smooth_contact(step, H, guess_alpha):
 
     start = max(now.alpha, 1e-12)
     alpha = root(residual, start, residual(start), max(guess_alpha, 1e-12), 0.0, math.inf,
-                  step.jump)
+                 step.jump, step.compiled_secant(H))
     if alpha is None or alpha <= 0.0:
         raise Lost("contact")
     return step.evaluate(alpha, edge_zone(step, H, alpha), H)

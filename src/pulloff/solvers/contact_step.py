@@ -80,7 +80,7 @@ def step_constants(setup) -> np.ndarray:
 
 
 #: The contact view of a law without arms (never read).
-_NO_CONTACTS = (np.zeros(0, dtype=np.int64), np.zeros((2, 0)))
+_NO_CONTACTS = (np.zeros(0, dtype=np.int64), np.zeros((2, 0)), np.zeros(1, dtype=np.int64))
 
 
 class Step:
@@ -101,9 +101,8 @@ class Step:
         self.before = before
         self.arm_mus = dt / law.tau_arms if law.maxwell else np.zeros(0)
         self.jump = False  # a zero-time transition: the phase's root is searched widely
-        self._free = None  # (x, modes) of the free elements at the start, gathered once
         self.k_alpha = self.k_beta = 0  # new elements per step (set by the stepper)
-        self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv)
+        self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv, law.V)
         # A step's trials share their lift (a driven one, or the balance's few): its path,
         # rate and the arms' filtered lift at the end are computed once per lift.
         self._driven = None
@@ -156,6 +155,7 @@ class Step:
         sc = self._constants
         k_beta = max(self.k_beta, int(4 * self.s.per_zone)) if self.fresh else self.k_beta
         sc[K.S_K_ALPHA], sc[K.S_K_BETA] = self.k_alpha, k_beta
+        sc[K.S_JUMP] = 1.0 if self.jump else 0.0
         return sc
 
     # --- paths over the step -------------------------------------------------------------
@@ -199,20 +199,19 @@ class Step:
     def contact_load(self, xi, H_new, Hdot, Hf):
         """Line load of a contact element at ``xi`` at the end of the step."""
         law = self.s.setup.law
+        if law.maxwell and not self.s.setup.flat:
+            # A smooth edge: the compiled formulas (kernels.contact.edge_load, which the
+            # compiled edge search evaluates too). In a jump the dashpots do not move: an
+            # element the contact reaches keeps the free state it had (virgin: none) and
+            # meets the indenter with the glassy modulus; beyond the contact the edge reaches
+            # a free element whose dashpots relax toward the indenter from the step's start.
+            nodes = self.s.nodes
+            sc = self.constants.copy()
+            sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+            mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            return K.edge_load(float(xi), mesh, self.law, self._stepw(Hf), self.s.setup.indenter.table,
+                               sc, nodes.n)
         G = self.s.setup.indenter.g(xi)
-        if law.maxwell and self.jump and not self.s.setup.flat:
-            # In a jump the dashpots do not move: an element the contact reaches keeps the
-            # free state it had (virgin: none), and meets the indenter with the glassy modulus.
-            E = law.V @ self.free_modes_at(xi)
-            return law.kappa_instant * (H_new + G) - float(np.dot(law.kappa_arms, E))
-        if law.maxwell and xi > self.now.alpha and not self.s.setup.flat:
-            # Beyond the contact the edge reaches a free element: its dashpots are where the
-            # free side left them, relaxing toward the indenter from the step's start.
-            E = law.V @ self.free_modes_at(xi)
-            D = E - self.now.Hf - self.s.setup.indenter.g(xi)
-            memory = float(np.dot(law.kappa_arms, D * np.exp(-self.dt / law.tau_arms)))
-            return (law.kappa_inf * (H_new + G) + float(np.dot(law.kappa_arms, H_new - Hf))
-                    - memory)
         if law.maxwell:
             memory = self.s.contact_memory(xi, self.now.t + self.dt, self.contacts[0])
             arms = 0.0
@@ -221,18 +220,11 @@ class Step:
             return law.kappa_inf * (H_new + G) + arms - memory
         return law.kappa_inf * (H_new + G) + law.c * Hdot
 
-    def free_modes_at(self, x):
-        """Modes of a free element at ``x`` at the step's start: interpolated between the
-        free elements around it (zero in virgin solid, beyond every element). The free
-        elements are gathered once per step: the trials of a step share them."""
-        if self._free is None:
-            nodes = self.s.nodes
-            idx = np.nonzero(nodes.status[:nodes.n] == st.FREE)[0]
-            self._free = (nodes.xi[idx], nodes.Y[idx, :self.s.setup.law.n_modes])
-        xs, Ys = self._free
-        if xs.size == 0 or x > xs[-1]:
-            return np.zeros(Ys.shape[1])
-        return np.array([np.interp(x, xs, Ys[:, k]) for k in range(Ys.shape[1])])
+    def _stepw(self, Hf1):
+        """The step's arrays the kernels take (``stepw``), with the arms' filtered lift
+        ``Hf1`` at the end."""
+        return (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, self.now.Hf, Hf1,
+                *self.contacts)
 
     def released_modes(self, x, s_c, H_new):
         """Modes of a contact element at ``x`` released at fraction ``s_c``: its dashpots from
@@ -250,13 +242,14 @@ class Step:
     def compiled_secant(self, H_new, alpha=None):
         """``contact_phases._secant`` compiled with its residual at the lift ``H_new``
         (:func:`pulloff.kernels.contact.edge_secant`: the same iterates, without Python
-        between them): for a flat punch's receding edge (``alpha`` None: the unknown is the
-        edge, the zone end from the edge condition) or for the zone end with the edge held at
-        ``alpha``. ``(x_held, f_held, x_guess, lo, hi, reach) -> root or None``. None (the
-        Python search then) where the step places its own elements (an elastic smooth
-        contact: its evaluations are not the compiled ones) and for a smooth indenter's edge
-        (its contact load is another formula)."""
-        if self.fresh or (alpha is None and not self.s.setup.flat):
+        between them): for an edge (``alpha`` None: the unknown is the edge, the zone end from
+        the edge condition: a flat punch's receding edge, a smooth one on a solid with arms)
+        or for the zone end with the edge held at ``alpha``. ``(x_held, f_held, x_guess, lo,
+        hi, reach) -> root or None``. None (the Python search then) where the step places
+        its own elements (an elastic smooth contact: its evaluations are not the compiled
+        ones)."""
+        if self.fresh or (alpha is None and not self.s.setup.flat
+                          and not self.s.setup.law.maxwell):
             return None
         s, now, before = self.s, self.now, self.before
         nodes, law = s.nodes, s.setup.law
@@ -272,8 +265,7 @@ class Step:
             # (the mesh as it is now: a Python evaluation may have brought archived elements
             # back since)
             mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
-            stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf1,
-                     *self.contacts)
+            stepw = self._stepw(Hf1)
             sc[K.S_LIVE_END] = nodes.live_end
             x, last = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh,
                                     self.law, stepw, table, sc, edges, lift, nodes.n)
@@ -320,8 +312,7 @@ class Step:
         sc = self.constants.copy()
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         while True:
-            stepw = (self.mus, self.decay, self.zdt, self.w3, self.arm_mus, now.Hf, Hf,
-                     *self.contacts)
+            stepw = self._stepw(Hf)
             mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
             _, lo, hi, m, out, res = K.trial_state(alpha, beta, mesh, self.law, stepw,
                                                    s.setup.indenter.table, sc, self.edges,
