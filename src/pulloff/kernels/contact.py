@@ -1056,8 +1056,9 @@ def edge_load(alpha, mesh, law, stepw, prof, sc0, n_all):
     ``contact_step.Step.contact_load`` gives it (the same sums in the same order: that calls
     this for a smooth indenter on a solid with arms). With arms, a smooth edge beyond where it
     was (or any edge in a jump, ``sc0[S_JUMP]``) meets a free element: its dashpots where the
-    free side left them (``stepw``'s free elements at the step's start, interpolated),
-    relaxing toward the indenter over the step, or held in a jump (the glassy modulus)."""
+    free side left them (the free elements at the step's start, interpolated:
+    :func:`_free_modes`), relaxing toward the indenter over the step, or held in a jump (the
+    glassy modulus)."""
     xi, Y, status, D, tj, t_last = mesh
     ctil, kappa_arms, tau_arms, V_inv, V = law
     H1 = sc0[S_H1]

@@ -59,6 +59,14 @@ class Law:
         slowest = -float(np.max(self.lam))
         return slowest if slowest > 1e-12 * self.fastest_decay else 0.0
 
+    @cached_property
+    def V_kernel(self) -> np.ndarray:
+        """``V`` in C order, as the kernels take it: the eigensolver's comes in Fortran order
+        with two arms or more, and numba compiled the step's kernels once more for that (15 s
+        from an empty cache where a Prony series ran after a standard linear solid). Python
+        keeps ``V`` itself: a product with the other layout rounds differently."""
+        return np.ascontiguousarray(self.V)
+
     @property
     def kappa_instant(self) -> float:
         return self.kappa_inf + float(np.sum(self.kappa_arms))

@@ -102,7 +102,7 @@ class Step:
         self.arm_mus = dt / law.tau_arms if law.maxwell else np.zeros(0)
         self.jump = False  # a zero-time transition: the phase's root is searched widely
         self.k_alpha = self.k_beta = 0  # new elements per step (set by the stepper)
-        self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv, law.V)
+        self.law = (law.ctil, law.kappa_arms, law.tau_arms, law.V_inv, law.V_kernel)
         # A step's trials share their lift (a driven one, or the balance's few): its path,
         # rate and the arms' filtered lift at the end are computed once per lift.
         self._driven = None
