@@ -1071,24 +1071,18 @@ def edge_load(alpha, mesh, law, stepw, prof, sc0, n_all):
         nm = V.shape[1]
         modes = np.zeros(nm)
         _free_modes(alpha, xi, Y, status, n_all, first_free[0], modes)
-        if sc0[S_JUMP] > 0.0:
-            instant = sc0[S_KAPPA]
-            held = 0.0
-            for i in range(na):
-                instant += kappa_arms[i]
-                E = 0.0
-                for k in range(nm):
-                    E += V[i, k] * modes[k]
-                held += kappa_arms[i] * E
-            return instant * (H1 + G) - held
-        memory = 0.0
-        arms = 0.0
+        instant = sc0[S_KAPPA]
+        held = memory = arms = 0.0
         for i in range(na):
-            E = 0.0
+            E = 0.0  # the arm's dashpot
             for k in range(nm):
                 E += V[i, k] * modes[k]
+            instant += kappa_arms[i]
+            held += kappa_arms[i] * E
             memory += kappa_arms[i] * (E - Hf0[i] - G) * math.exp(-sc0[S_DT] / tau_arms[i])
             arms += kappa_arms[i] * (H1 - Hf1[i])
+        if sc0[S_JUMP] > 0.0:
+            return instant * (H1 + G) - held
         return sc0[S_KAPPA] * (H1 + G) + arms - memory
     arms = 0.0
     for i in range(na):

@@ -56,6 +56,12 @@ class Nodes:
             setattr(self, name, new)
 
     @property
+    def mesh(self) -> tuple:
+        """The columns as the kernels take them (``kernels.contact``'s ``mesh``): read anew
+        each time, since growing the arrays replaces them."""
+        return (self.xi, self.Y, self.status, self.D, self.tj, self.t_last)
+
+    @property
     def total(self) -> int:
         """Elements live and archived."""
         return self.n + sum(block[0].size for block in self._archive)

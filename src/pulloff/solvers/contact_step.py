@@ -208,7 +208,7 @@ class Step:
             nodes = self.s.nodes
             sc = self.constants.copy()
             sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
-            mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            mesh = nodes.mesh
             return K.edge_load(float(xi), mesh, self.law, self._stepw(Hf), self.s.setup.indenter.table,
                                sc, nodes.n)
         G = self.s.setup.indenter.g(xi)
@@ -264,7 +264,7 @@ class Step:
         def secant(x_held, f_held, x_guess, lo, hi, reach):
             # (the mesh as it is now: a Python evaluation may have brought archived elements
             # back since)
-            mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            mesh = nodes.mesh
             stepw = self._stepw(Hf1)
             sc[K.S_LIVE_END] = nodes.live_end
             x, last = K.edge_secant(x_held, f_held, x_guess, lo, hi, reach, held, mesh,
@@ -313,7 +313,7 @@ class Step:
         sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
         while True:
             stepw = self._stepw(Hf)
-            mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+            mesh = nodes.mesh
             _, lo, hi, m, out, res = K.trial_state(alpha, beta, mesh, self.law, stepw,
                                                    s.setup.indenter.table, sc, self.edges,
                                                    lift, nodes.n)

@@ -788,7 +788,7 @@ class Stepper:
         growth asks for :meth:`_commit_elements` (most steps: its array operations on a few
         dozen elements were a fifth of a standard linear solid's run); whether it was."""
         nodes, law = self.nodes, self.setup.law
-        mesh = (nodes.xi, nodes.Y, nodes.status, nodes.D, nodes.tj, nodes.t_last)
+        mesh = nodes.mesh
         added, inside = K.commit_plain(mesh, nodes.n, ev.lo, ev.hi, ev.xi, ev.Y, ev.flags,
                                        ev.alpha, t1, nodes.live_end, self._furthest)
         if added < 0:
