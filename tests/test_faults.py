@@ -289,9 +289,15 @@ def _alive(pid: int) -> bool:
     return "\nState:\tZ" not in status  # a zombie has exited
 
 
+LONG_SWEEP_POINTS = 100_000
+
+
 def _long_sweep(out: Path):
-    """A 3000-scene sweep on two workers, once both workers run: ``(process, worker pids)``."""
-    proc = _pulloff("sweep", SEED, "--vary", "loading.v=log:1e-4:1e-2:3000", "-o", out,
+    """A sweep on two workers that cannot end before the test signals it (100 000 seed scenes,
+    ~2 min on two cores; 3000 had ended before the signal on a fast machine), once both
+    workers run: ``(process, worker pids)``."""
+    proc = _pulloff("sweep", SEED, "--vary", f"loading.v=log:1e-4:1e-2:{LONG_SWEEP_POINTS}",
+                    "-o", out,
                     "--workers", "2", "-q")
     _wait_for(lambda: len(_children(proc.pid)) >= 2, what="two workers")
     return proc, _children(proc.pid)
@@ -314,9 +320,9 @@ def test_sighup_of_a_sweep_keeps_its_rows_and_ends_its_workers(tmp_path):
     assert "SIGHUP" in err and "resume" in err and "Traceback" not in err
     _wait_for(lambda: not any(_alive(w) for w in workers), timeout=5, what="workers to end")
     result = pulloff.load(out)
-    assert result.complete is False and result.n_points == 3000
+    assert result.complete is False and result.n_points == LONG_SWEEP_POINTS
     kept = result.table["index"]
-    assert 0 < kept.size < 3000 and np.all(result.table["status"] == "ok")
+    assert 0 < kept.size < LONG_SWEEP_POINTS and np.all(result.table["status"] == "ok")
     assert h5io.stale_temp_files(out) == []
 
 
