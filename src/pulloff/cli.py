@@ -108,7 +108,7 @@ def _compile_notice(args) -> None:
 
     if not getattr(args, "quiet", False) and not cache_is_warm():
         print("pulloff: compiling the numba kernels for this machine (first run only: "
-              "~10 s for an onset, ~45 s for a moving contact edge)",
+              "5-15 s for an onset, 20-50 s for a moving contact edge)",
               file=sys.stderr, flush=True)
 
 
