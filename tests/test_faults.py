@@ -289,12 +289,12 @@ def _alive(pid: int) -> bool:
     return "\nState:\tZ" not in status  # a zombie has exited
 
 
-LONG_SWEEP_POINTS = 100_000
+LONG_SWEEP_POINTS = 50_000  # (below sweeps.MAX_POINTS, the default cap)
 
 
 def _long_sweep(out: Path):
-    """A sweep on two workers that cannot end before the test signals it (100 000 seed scenes,
-    ~2 min on two cores; 3000 had ended before the signal on a fast machine), once both
+    """A sweep on two workers that cannot end before the test signals it (50 000 seed scenes,
+    ~25 s on two cores of a fast machine; 3000 had ended before the signal there), once both
     workers run: ``(process, worker pids)``."""
     proc = _pulloff("sweep", SEED, "--vary", f"loading.v=log:1e-4:1e-2:{LONG_SWEEP_POINTS}",
                     "-o", out,

@@ -233,11 +233,15 @@ class Stepper:
         self.row_Hf.append(now.Hf.copy())
 
     # --- where new elements go ------------------------------------------------------------
+    @staticmethod
+    def _zone_width(now) -> float:
+        width = now.beta - now.alpha if now.beta > now.alpha else now.beta
+        return max(width, 1e-9 * max(now.beta, 1.0))
+
     def spacing(self, now) -> float:
         """Target distance between the elements a receding edge releases: a
         ``per_release``-th of the zone's width."""
-        width = now.beta - now.alpha if now.beta > now.alpha else now.beta
-        return max(width, 1e-9 * max(now.beta, 1.0)) / self.per_release
+        return self._zone_width(now) / self.per_release
 
     def make_step(self, dt) -> Step:
         """A trial step of ``dt``, with the number of new elements chosen from the motion the
@@ -1042,7 +1046,9 @@ class Stepper:
         nodes = self.nodes
         law = self.setup.law
         if self.setup.flat and now.alpha > 0.0:
-            count = max(2, int(math.ceil(now.alpha / self.spacing(now))))
+            # (per_zone, not per_release: no edge is left to resolve, and a thin zone would
+            # put alpha / width times per_release elements on the face)
+            count = max(2, int(math.ceil(now.alpha / (self._zone_width(now) / self.per_zone))))
             for x in np.linspace(0.0, now.alpha, count + 1)[:-1]:
                 if not nodes.near(float(x), 1e-14):
                     nodes.insert(float(x), status=st.CONTACT, t_last=now.t)
