@@ -61,8 +61,12 @@ ONSET_SHRINK = 256.0
 #: way): near ``a ~ (t_0 - t)^(1/3)`` the balance is ill-conditioned and a step can fail
 #: while a longer one from the same state succeeds. compliant_machine.yaml at n = 128 and
 #: 256 lost it at a = 0.155 and 0.095 R, 11.7 steps before the end, and reported an arrest;
-#: landed, they separate 3.9e-7 and 8.5e-8 off the reference.
+#: landed, they separate 3.9e-7 and 8.5e-8 off the reference. The horizon is this many
+#: steps at n <= 128 and the same time above (steps at n are 1/n of the run's scale): the
+#: balance is lost near a = 0.155 R at every level, which at n = 512 is 43 steps before the
+#: end, and with 32 steps there the run reported an arrest and no separation.
 _LOST_BALANCE_HORIZON = 32.0
+_LOST_BALANCE_N = 128
 #: The force range the steps start from under a driven lift [sigma_c L^2] (it grows with the
 #: force seen): the order of a flat punch's strength limit (pi R^2 sigma_c). From 1e-3 a
 #: bonded phase resolved its force on a log scale from t = 0 (sls_finite_punch at n = 32:
@@ -277,8 +281,9 @@ class Stepper:
         now 6.4e-6, -7.6e-7, -2.0e-7, -1.2e-9 against the onset solver. Behind 1 and 10 N/m
         (compliant_machine) the onset force's error at rtol 1e-3 fell from 1.1e-5 and
         2.1e-5 to below 1.6e-6. The cap: 4 gave the slow pull 2-100x less error but took
-        compliant_machine behind 1 N/m from 16 s to 35 s at rtol 1e-3 (20 s now; unthinned
-        behind a spring, its entering elements stay), 1 took the one behind 10 N/m to 14 s
+        compliant_machine behind 1 N/m from 16 s to 35 s at rtol 1e-3 (20 s then; unthinned
+        behind a spring then, its entering elements stayed; thinned since the thirteenth
+        session), 1 took the one behind 10 N/m to 14 s
         (a bisection; 3.8 s now, 12 s before). Those times hinge on whether a level falls
         into the bisection after a lost balance, which flips with small changes of state
         (README, Known issues)."""
@@ -718,7 +723,8 @@ class Stepper:
         at one time); otherwise step to the longest step that works (by bisection) and try
         again from there."""
         if (what == "balance" and self.setup.law.c > 0.0
-                and self._bond_vanishes(_LOST_BALANCE_HORIZON)):
+                and self._bond_vanishes(_LOST_BALANCE_HORIZON
+                                        * max(1.0, self.n / _LOST_BALANCE_N))):
             return
         try:
             self.solve(self.make_step(1e-12 * dt))
