@@ -30,7 +30,11 @@ GROWING = (st.BONDED,)
 #: thousandth of the zone; with twice it, every level n = 16..512 of the 1, 10 and 100 N/m
 #: scenes is regular and as accurate as unthinned (behind 1 N/m 5.4e-6 .. 2.1e-9 in the
 #: separation time), and compliant_machine at n = 256 takes 16 s against 48 s unthinned.
-#: (A run that ends at its onset was thinned with the driven factor before, and still is.)
+#: A run that ends at its onset, and an elastic solid, were thinned with the driven factor
+#: before and still are. A path under force control or behind a spring (``until`` "path")
+#: with memory is thinned with the margin (it was not thinned). Its factor follows the
+#: segment: a driven segment of a mixed path thins with the driven factor, and what it
+#: removed is not put back.
 BALANCED_MARGIN = 2.0
 
 
@@ -233,8 +237,10 @@ def thin(stepper) -> int:
     # but it did unthinned as well, from a horizon counted in steps: _LOST_BALANCE_N).
     if now.beta <= 0.0 or now.beta <= now.alpha or now.phase not in GROWING:
         return 0
-    past_onset_balanced = not stepper.lift_driven and stepper.setup.until != "detach"
-    factor = thin_factor(stepper.setup.law) * (BALANCED_MARGIN if past_onset_balanced else 1.0)
+    law = stepper.setup.law
+    balanced_run_past_onset = (not stepper.lift_driven and stepper.setup.until != "detach"
+                               and not _stateless(law))
+    factor = thin_factor(law) * (BALANCED_MARGIN if balanced_run_past_onset else 1.0)
     lo, hi = nodes.below(now.alpha), nodes.below(now.beta)
     idx = np.arange(lo, hi)
     idx = idx[(nodes.status[lo:hi] == st.FREE) & (nodes.xi[lo:hi] > now.alpha)
