@@ -17,11 +17,9 @@ for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MK
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import statistics  # noqa: E402
-import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from common import machine_summary  # noqa: E402
+from common import machine_summary, time_call  # noqa: E402
 from pulloff import solvers  # noqa: E402
 from pulloff.io.scene_file import load_scene  # noqa: E402
 
@@ -37,14 +35,11 @@ def kelvin_voigt_counterpart(scene) -> str:
 
 
 def timed(scene, repeat):
-    """``(median seconds, result)`` of warm runs."""
-    solvers.simulate(scene)
-    times, result = [], None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        result = solvers.simulate(scene)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), result
+    """``(median seconds, result)`` of warm runs (:func:`common.time_call`)."""
+    solvers.simulate(scene)  # warm: compile or load numba's cache
+    timing, result = time_call(lambda: solvers.simulate(scene), min_repeats=repeat,
+                               min_total=0.0)
+    return timing.median, result
 
 
 def main() -> None:
