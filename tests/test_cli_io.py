@@ -250,3 +250,36 @@ def test_cli_run_without_a_plot(tmp_path):
     assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot"]) == 0
     assert out.exists() and not out.with_suffix(".png").exists()
     assert h5io.load(out)["summary"]["detached"]
+
+
+@pytest.mark.parametrize("config,kernel", [("seed_flat_punch", "onset.march"),
+                                           ("separation_kv", "contact.evaluate_step"),
+                                           ("frozen_history", None)])
+def test_the_compile_notice_follows_the_kernels_the_scene_needs(config, kernel, tmp_path,
+                                                                 monkeypatch, capsys):
+    """Once the cache holds a solver's kernels, its runs say nothing; a scene of another
+    solver still does. (The check once looked for a moving-edge kernel whatever the run: an
+    onset run said it was compiling on every call until a moving-edge scene had run.)"""
+    import argparse
+
+    from numba.core import config as numba_config
+
+    from pulloff import cli
+
+    scene = load_scene(CONFIGS / f"{config}.yaml")
+    args = argparse.Namespace(quiet=False)
+    monkeypatch.setattr(numba_config, "CACHE_DIR", str(tmp_path))
+    cli._compile_notice(args, scene)
+    assert ("compiling" in capsys.readouterr().err) == (kernel is not None)
+    if kernel is None:
+        return
+    other = "contact.evaluate_step" if kernel.startswith("onset") else "onset.march"
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / f"{other}-1.py311.nbi").write_bytes(b"")
+    cli._compile_notice(args, scene)
+    assert "compiling" in capsys.readouterr().err  # another solver's kernels do not count
+    (tmp_path / "pkg" / f"{kernel}-1.py311.nbi").write_bytes(b"")
+    cli._compile_notice(args, scene)
+    assert capsys.readouterr().err == ""
+    cli._compile_notice(argparse.Namespace(quiet=True), scene)
+    assert capsys.readouterr().err == ""

@@ -51,7 +51,7 @@ def _cmd_run(args) -> int:
         with h5io.atomic_file(out, key) as f:
             # A fixed-step run streams its history into the file while it runs.
             stream = h5io.HistoryStream(f) if scene.numerics.steps is not None else None
-            _compile_notice(args)
+            _compile_notice(args, scene)
             result = solvers.simulate(scene, progress=_progress(args), stream=stream)
             record = h5io.result_to_record(result, scene_to_yaml(scene))
             h5io.fill(f, record, history_streamed=result.history_streamed)
@@ -102,11 +102,14 @@ def _cmd_sweep(args) -> int:
     return 0
 
 
-def _compile_notice(args) -> None:
-    """Say once, before a first run's long silence, that the kernels are being compiled."""
+def _compile_notice(args, scene) -> None:
+    """Say once, before a first run's long silence, that the kernels the scene's solver needs
+    are being compiled."""
+    from . import solvers
     from .kernels import cache_is_warm
 
-    if not getattr(args, "quiet", False) and not cache_is_warm():
+    kernel = solvers.route(scene).kernel
+    if not getattr(args, "quiet", False) and kernel is not None and not cache_is_warm(kernel):
         print("pulloff: compiling the numba kernels for this machine (first run only: "
               "5-15 s for an onset, 20-50 s for a moving contact edge)",
               file=sys.stderr, flush=True)

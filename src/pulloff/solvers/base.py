@@ -12,6 +12,9 @@ class Solver:
 
     name = ""
     summary = ""
+    #: The numba kernel (``"module.function"`` under :mod:`pulloff.kernels`) whose cached
+    #: copy says this solver's kernels are compiled; None: it compiles none.
+    kernel: str | None = None
 
     def unsupported(self, scene) -> list[str]:
         raise NotImplementedError

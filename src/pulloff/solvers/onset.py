@@ -389,6 +389,7 @@ class OnsetSolver(Solver):
     elastic) solid, a rigid machine pulling at constant speed; exact load history."""
 
     name = "onset"
+    kernel = "onset.march"
     summary = "seed onset stepper (flat punch, external zone, Kelvin-Voigt, rigid pull)"
 
     def unsupported(self, scene) -> list[str]:
