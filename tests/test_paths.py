@@ -134,6 +134,36 @@ def test_flat_punch_through_a_path_gives_the_pull_numbers():
     assert path.F_pulloff == pytest.approx(pull.F_peak_total, rel=1e-3)
 
 
+@pytest.mark.parametrize("config", ["separation_elastic", "finite_punch_internal"])
+def test_an_elastic_flat_punch_under_a_force_ramp_hold_and_ramp_pulls_off_at_its_onset(config):
+    """A multi-segment force-controlled path on a flat punch (zone outside and on the face):
+    ramp to a third of the pull-off, hold 0.05 s, ramp to separation. An elastic punch comes
+    off at its elastic onset force whatever the path (the closed form beside the run,
+    analytic.elastic_mdr_dugdale / elastic_internal_onset), after the two ramps and the hold.
+    Measured: 1e-11 .. 4e-11 off in the force at rtol 1e-6 (under load and displacement
+    control, behind springs of 1 and 100 N/m too)."""
+    from pulloff.model import analytic
+
+    base = load_scene(CONFIGS / f"{config}.yaml")
+    geometry = base.geometry
+    G, rate, hold = base.material.G, 0.01, 0.05
+    onset = analytic._elastic_onset(G, base.adhesion.sigma_c, base.adhesion.delta,
+                                    geometry.radius, geometry.cohesive_zone == "internal")
+    scene = load_scene(CONFIGS / f"{config}.yaml", overrides=[
+        "material={kind: elastic, G: %r}" % G, "numerics.rtol=1e-6",
+        "loading={kind: path, control: force, segments: [{force_rate: %r, until: {force: %r}},"
+        " {hold: %r}, {force_rate: %r, until: separation}]}"
+        % (rate, onset["F_total"] / 3, hold, rate)])
+    result = solvers.simulate(scene)
+    forms = result.analytic
+    assert forms["mdr_dugdale_F_pulloff_load"] == pytest.approx(onset["F_total"], rel=1e-14)
+    assert forms["jkr_F_pulloff_load"] == pytest.approx(
+        analytic.kendall_force(G, base.adhesion.gamma, geometry.radius), rel=1e-14)
+    assert result.F_pulloff == pytest.approx(onset["F_total"], rel=1e-6)
+    assert result.t_pulloff == pytest.approx(onset["F_total"] / rate + hold, rel=1e-6)
+    assert result.F_jump_out == result.F_pulloff
+
+
 def test_force_controlled_kelvin_voigt_punch_still_comes_off():
     """Under a driven force (no machine spring) a lost balance is the load-controlled
     pull-off, not the crack arrest of a Kelvin-Voigt bond behind a spring (the review found
@@ -268,6 +298,22 @@ def test_a_solid_with_memory_gets_its_two_elastic_limits_beside_the_run():
                                           delta=scene.adhesion.delta, control="load").F
         assert forms[key] == pytest.approx(expected, rel=1e-12)
     assert math.isnan(forms["maugis_F_pulloff_load"])  # the elastic closed forms are not
+
+
+def test_a_flat_punch_with_memory_on_a_path_gets_the_onset_forces_of_its_two_moduli():
+    from pulloff.model import analytic
+
+    scene = load_scene(CONFIGS / "sls_finite_punch.yaml", overrides=[
+        "loading={kind: path, segments: [{speed: 1.0e-4, until: separation}]}"])
+    forms = analytic.path_predictions(scene)
+    spectrum, geometry = scene.material.spectrum(), scene.geometry
+    for key, modulus in (("relaxed_F_pulloff", spectrum.G_inf),
+                         ("instant_F_pulloff", spectrum.instantaneous_modulus)):
+        expected = analytic.elastic_internal_onset(modulus, scene.adhesion.sigma_c,
+                                                   scene.adhesion.delta, geometry.radius)
+        assert forms[key] == pytest.approx(expected["F_total"], rel=1e-14)
+    assert forms["instant_F_pulloff"] > forms["relaxed_F_pulloff"]
+    assert math.isnan(forms["mdr_dugdale_F_pulloff_load"])
 
 
 def test_the_closed_forms_beside_a_path_are_kept_per_process_and_never_stale():

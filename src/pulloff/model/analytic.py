@@ -727,9 +727,10 @@ _PATH_CACHE_SIZE = 64
 
 
 def path_predictions(scene) -> dict:
-    """The closed forms beside a smooth indenter's path on an elastic solid, SI, keyed as in
-    :mod:`pulloff.model.outputs` (nan where they do not apply: a solid with memory, a flat
-    punch)."""
+    """The closed forms beside an indenter's path, SI, keyed as in :mod:`pulloff.model.outputs`
+    (nan where they do not apply): a smooth indenter's elastic pull-off curves, or a flat
+    punch's elastic onset force (its pull-off on any path); with Maxwell arms the elastic
+    limits of the relaxed and instantaneous moduli."""
     key = json.dumps([scene.geometry.model_dump(mode="json"),
                       scene.material.model_dump(mode="json"),
                       scene.adhesion.model_dump(mode="json"),
@@ -747,7 +748,7 @@ def _path_predictions(scene) -> dict:
     out = dict.fromkeys(PATH_KEYS, math.nan)
     geometry, spectrum = scene.geometry, scene.material.spectrum()
     if geometry.kind == "flat_punch":
-        return out
+        return _flat_punch_path(scene, spectrum, out)
     G = spectrum.G_inf
     sigma_c, delta, gamma = scene.adhesion.sigma_c, scene.adhesion.delta, scene.adhesion.gamma
     if geometry.kind == "profile":
@@ -774,3 +775,24 @@ def _path_predictions(scene) -> dict:
                 geometry.radius, G, sigma_c, gamma, control)
     return out
 
+
+def _flat_punch_path(scene, spectrum, out: dict) -> dict:
+    """A flat punch's elastic pull-off on any path is its onset force: the force rises with
+    the lift until the onset, where the elastic crack runs (the simulator's F_pulloff agrees
+    to 1e-10 under load and displacement control, behind springs of 1 and 100 N/m, with the
+    zone outside and on the face). Kendall's force is the short-range limit. A solid with
+    Maxwell arms gets the onset forces of its relaxed and instantaneous moduli instead."""
+    sigma_c, delta, gamma = scene.adhesion.sigma_c, scene.adhesion.delta, scene.adhesion.gamma
+    a, internal = scene.geometry.radius, scene.geometry.cohesive_zone == "internal"
+    G = spectrum.G_inf
+    if spectrum.relaxation_times:
+        for key, modulus in (("relaxed", G), ("instant", spectrum.instantaneous_modulus)):
+            if modulus > 0 and math.isfinite(modulus):
+                out[f"{key}_F_pulloff"] = _elastic_onset(modulus, sigma_c, delta, a,
+                                                         internal)["F_total"]
+        return out
+    if G > 0:
+        F = _elastic_onset(G, sigma_c, delta, a, internal)["F_total"]
+        out["mdr_dugdale_F_pulloff_load"] = out["mdr_dugdale_F_pulloff_displacement"] = F
+        out["jkr_F_pulloff_load"] = kendall_force(G, gamma, a)
+    return out

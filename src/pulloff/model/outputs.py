@@ -22,9 +22,9 @@ WHERE = {
     "path": "scenes with a loading path (loading.kind = path)",
     "jump": "paths where the contact is gained or lost by a jump",
     "sphere": "spheres",
-    "elastic_path": "elastic solids under a smooth indenter on a loading path",
-    "memory_path": "solids with memory (standard linear solid, Prony series) under a smooth "
-                   "indenter on a loading path",
+    "elastic_path": "elastic and Kelvin-Voigt solids on a loading path (a flat punch: its "
+                    "elastic onset force, its pull-off on any path)",
+    "memory_path": "solids with memory (standard linear solid, Prony series) on a loading path",
 }
 
 
