@@ -268,6 +268,8 @@ def test_the_compile_notice_follows_the_kernels_the_scene_needs(config, kernel, 
 
     scene = load_scene(CONFIGS / f"{config}.yaml")
     args = argparse.Namespace(quiet=False)
+    # The fallback that reads the cache folder (numba's own index is asked first, below)
+    monkeypatch.setattr("pulloff.kernels.cached_entries", lambda name: None)
     monkeypatch.setattr(numba_config, "CACHE_DIR", str(tmp_path))
     cli._compile_notice(args, scene)
     assert ("compiling" in capsys.readouterr().err) == (kernel is not None)
@@ -283,3 +285,14 @@ def test_the_compile_notice_follows_the_kernels_the_scene_needs(config, kernel, 
     assert capsys.readouterr().err == ""
     cli._compile_notice(argparse.Namespace(quiet=True), scene)
     assert capsys.readouterr().err == ""
+
+
+def test_numba_is_asked_whether_a_solvers_kernel_is_cached():
+    """After a run the outermost kernel of its solver is in numba's own index (an index of
+    an older source, or none, counts as cold: the review found stale index files of moved
+    kernels in the package's __pycache__, which the folder check took as warm)."""
+    from pulloff.kernels import cache_is_warm, cached_entries
+
+    simulate(load_scene(SEED))
+    assert cached_entries("onset.march") >= 1
+    assert cache_is_warm("onset.march")

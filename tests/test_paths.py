@@ -300,7 +300,7 @@ def test_a_solid_with_memory_gets_its_two_elastic_limits_beside_the_run():
     assert math.isnan(forms["maugis_F_pulloff_load"])  # the elastic closed forms are not
 
 
-def test_a_flat_punch_with_memory_on_a_path_gets_the_onset_forces_of_its_two_moduli():
+def test_a_flat_punch_with_memory_on_a_path_gets_the_onset_forces_of_its_moduli():
     from pulloff.model import analytic
 
     scene = load_scene(CONFIGS / "sls_finite_punch.yaml", overrides=[
@@ -313,6 +313,17 @@ def test_a_flat_punch_with_memory_on_a_path_gets_the_onset_forces_of_its_two_mod
                                                    scene.adhesion.delta, geometry.radius)
         assert forms[key] == pytest.approx(expected["F_total"], rel=1e-14)
     assert forms["instant_F_pulloff"] > forms["relaxed_F_pulloff"]
+    assert math.isnan(forms["mdr_dugdale_F_pulloff_load"])
+    # A Kelvin-Voigt punch: the relaxed limit only (its instantaneous modulus is infinite),
+    # and no single elastic pull-off (the review found it given the elastic solid's keys'
+    # labels while the code gave it the relaxed one)
+    kv = load_scene(CONFIGS / "finite_punch_internal.yaml", overrides=[
+        "loading={kind: path, segments: [{speed: 1.0e-3, until: separation}]}"])
+    forms = analytic.path_predictions(kv)
+    expected = analytic.elastic_internal_onset(kv.material.G, kv.adhesion.sigma_c,
+                                               kv.adhesion.delta, kv.geometry.radius)
+    assert forms["relaxed_F_pulloff"] == pytest.approx(expected["F_total"], rel=1e-14)
+    assert math.isnan(forms["instant_F_pulloff"])
     assert math.isnan(forms["mdr_dugdale_F_pulloff_load"])
 
 

@@ -89,7 +89,6 @@ def _cmd_sweep(args) -> int:
     sweep_mod.check_size(sweep_mod.grid_size(axes), max_points)
     scene = load_scene(args.config, overrides=args.set or ())
     start = time.perf_counter()
-    _compile_notice(args, scene)  # (every worker process loads or compiles the kernels)
     try:
         result = sweep_mod.sweep(scene, axes, out=out, workers=args.workers,
                                  scheduler=args.scheduler, histories=args.histories,

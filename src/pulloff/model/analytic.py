@@ -777,15 +777,17 @@ def _path_predictions(scene) -> dict:
 
 
 def _flat_punch_path(scene, spectrum, out: dict) -> dict:
-    """A flat punch's elastic pull-off on any path is its onset force: the force rises with
+    """An elastic flat punch's pull-off on any path is its onset force: the force rises with
     the lift until the onset, where the elastic crack runs (the simulator's F_pulloff agrees
     to 1e-10 under load and displacement control, behind springs of 1 and 100 N/m, with the
     zone outside and on the face). Kendall's force is the short-range limit. A solid with
-    Maxwell arms gets the onset forces of its relaxed and instantaneous moduli instead."""
+    memory gets the onset forces of its relaxed modulus (a slow pull's limit) and, with
+    Maxwell arms, of its instantaneous one (a fast pull's; a Kelvin-Voigt solid's is
+    infinite): its pull-off depends on the rate, so no single elastic value is its own."""
     sigma_c, delta, gamma = scene.adhesion.sigma_c, scene.adhesion.delta, scene.adhesion.gamma
     a, internal = scene.geometry.radius, scene.geometry.cohesive_zone == "internal"
     G = spectrum.G_inf
-    if spectrum.relaxation_times:
+    if spectrum.relaxation_times:  # Kelvin-Voigt (eta/G) or Maxwell arms
         for key, modulus in (("relaxed", G), ("instant", spectrum.instantaneous_modulus)):
             if modulus > 0 and math.isfinite(modulus):
                 out[f"{key}_F_pulloff"] = _elastic_onset(modulus, sigma_c, delta, a,

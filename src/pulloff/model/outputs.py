@@ -22,9 +22,11 @@ WHERE = {
     "path": "scenes with a loading path (loading.kind = path)",
     "jump": "paths where the contact is gained or lost by a jump",
     "sphere": "spheres",
-    "elastic_path": "elastic and Kelvin-Voigt solids on a loading path (a flat punch: its "
-                    "elastic onset force, its pull-off on any path)",
-    "memory_path": "solids with memory (standard linear solid, Prony series) on a loading path",
+    "elastic_path": "elastic solids on a loading path (a flat punch: its elastic onset "
+                    "force, its pull-off on any path)",
+    "memory_path": "solids with memory on a loading path: standard linear solids and Prony "
+                   "series, and Kelvin-Voigt flat punches (whose instantaneous modulus is "
+                   "infinite: relaxed only)",
 }
 
 
