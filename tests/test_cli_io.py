@@ -210,9 +210,10 @@ def test_ctrl_c_leaves_a_valid_file_marked_incomplete(tmp_path, capsys, monkeypa
 
     monkeypatch.setattr(onset_kernels, "march", march_then_interrupt)
     out = tmp_path / "cut.h5"
-    # A fixed-step run long enough to be marched in chunks (an rtol ladder's levels stop
-    # below the chunk size on the seed scene, even at rtol 1e-10).
-    assert main(["run", str(SEED), "-o", str(out), "-q", "--set", "numerics.steps=20000"]) == 130
+    # A snapshot splits each rtol level into chunks (the seed's levels no longer reach the
+    # chunk size of 2048 steps, even at rtol 1e-10; a fixed-step run is test_long_runs')
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--set", "numerics.rtol=1e-8",
+                 "--set", "output.snapshots=[0.005]"]) == 130
     assert "complete = False" in capsys.readouterr().err
     rec = h5io.load(out)
     assert rec["complete"] is False
