@@ -75,3 +75,22 @@ def test_each_rtol_on_hard_cases(name, rtol):
     error = abs(res.F_contact_detach / ref["F_contact"] - 1)
     assert error <= rtol
     assert res.error_estimate >= error / 10.0 or error < FLOOR
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-8])
+@pytest.mark.parametrize("G", [1e-2, 1e-1, 1.0, 10.0])
+def test_nearly_viscous_solids_whose_zone_barely_grows(G, rtol):
+    """near_viscous with G raised to 1e-2 .. 10 Pa (relaxation times 1e7 .. 1e4 s against a
+    1.6 ms pull): the zone grows by k t = 3e-11 .. 3e-8 inside the last interval of the
+    preloaded mesh, and the ladder's extrapolations creep (README, Known issues). Measured:
+    every rtol from 1e-6 to 1e-9 met, the estimate down to 1/8.7 of the error at rtol 1e-8
+    (G = 0.1) and to 1/15 at rtol 1e-9 (G = 1e-2, not asserted here: the known issue)."""
+    res = simulate(load_scene(HARD / "near_viscous.yaml",
+                              overrides=[f"material.G={G}", f"numerics.rtol={rtol}"]))
+    p = res.problem
+    ref = reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=1e-12)
+    error = max(abs(res.t_detach / ref["t_detach"] - 1),
+                abs(res.F_contact_detach / ref["F_contact"] - 1),
+                abs(res.F_total_detach / ref["F_total"] - 1))
+    assert error <= rtol
+    assert res.error_estimate >= error / 10.0 or error < FLOOR
