@@ -206,11 +206,9 @@ class Step:
             # meets the indenter with the glassy modulus; beyond the contact the edge reaches
             # a free element whose dashpots relax toward the indenter from the step's start.
             nodes = self.s.nodes
-            sc = self.constants.copy()
-            sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
-            mesh = nodes.mesh
-            return K.edge_load(float(xi), mesh, self.law, self._stepw(Hf), self.s.setup.indenter.table,
-                               sc, nodes.n)
+            return K.edge_load(float(xi), nodes.mesh, self.law, self._stepw(Hf),
+                               self.s.setup.indenter.table, self._constants_at(H_new, Hdot),
+                               nodes.n)
         G = self.s.setup.indenter.g(xi)
         if law.maxwell:
             memory = self.s.contact_memory(xi, self.now.t + self.dt, self.contacts[0])
@@ -219,6 +217,12 @@ class Step:
                 arms += kappa * lag  # in order, as the compiled edge search sums them
             return law.kappa_inf * (H_new + G) + arms - memory
         return law.kappa_inf * (H_new + G) + law.c * Hdot
+
+    def _constants_at(self, H_new, Hdot):
+        """A copy of the step's constants with the lift ``H_new`` and its rate at the end."""
+        sc = self.constants.copy()
+        sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+        return sc
 
     def _stepw(self, Hf1):
         """The step's arrays the kernels take (``stepw``), with the arms' filtered lift
@@ -254,8 +258,7 @@ class Step:
         s, now, before = self.s, self.now, self.before
         nodes, law = s.nodes, s.setup.law
         lift, Hdot, Hf = self._end_of(H_new)
-        sc = self.constants.copy()
-        sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+        sc = self._constants_at(H_new, Hdot)
         edges = self.edges
         Hf1 = Hf if law.maxwell else now.Hf
         table = s.setup.indenter.table
@@ -309,8 +312,7 @@ class Step:
         lift, Hdot, Hf = self._end_of(H_new)
         if not law.maxwell:
             Hf = now.Hf
-        sc = self.constants.copy()
-        sc[K.S_H1], sc[K.S_HDOT] = H_new, Hdot
+        sc = self._constants_at(H_new, Hdot)
         while True:
             stepw = self._stepw(Hf)
             mesh = nodes.mesh
