@@ -75,10 +75,11 @@ def test_no_detachment_before_t_max():
 @pytest.mark.parametrize("rtol", [1e-3, 1e-6, 1e-8])
 @pytest.mark.parametrize("name", DETACHING)
 def test_each_rtol_on_hard_cases(name, rtol):
+    """Every output the onset reports (its time and both forces), not the contact force
+    alone: on a thin zone the force follows the lift and the time's error is up to 3000x the
+    force's (metre_punch at rtol 1e-6: 9.6e-9 against 3.1e-12)."""
     res = run(name, rtol)
-    p = res.problem
-    ref = reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=1e-12)
-    error = abs(res.F_contact_detach / ref["F_contact"] - 1)
+    error = largest_error(res)
     assert error <= rtol
     assert res.error_estimate >= error / 10.0 or error < FLOOR
 
