@@ -329,7 +329,8 @@ def test_compliant_machine_separation_converges_to_the_reference():
     ref = REFERENCE["compliant_machine"]
     scene = load_scene(CONFIGS / "compliant_machine.yaml", overrides=["model.until=separation"])
     level = contact.run_level(scene, 64)
-    assert [name for _, name in level.events] == ["onset", "contact", "balance", "separated"]
+    assert [name for _, name in level.events] == ["onset", "contact", "balance", "jump_out",
+                                                  "separated"]
     assert level.rows[-2][2] == 0.0 and level.rows[-2][5] == 0.0  # the bond's last point
     assert level.summary["t_separation"] == pytest.approx(ref["t_separation"], rel=4e-5)
     assert level.summary["F_peak_total"] == pytest.approx(ref["F_peak_total"], rel=6e-5)
@@ -353,7 +354,8 @@ def test_a_bond_landed_on_its_end_without_a_zone_state_lets_its_elements_go(monk
 
     monkeypatch.setattr(contact_stepper.Stepper, "solve", no_zone_alone)
     forced = contact.run_level(scene, 32)
-    assert [name for _, name in forced.events] == ["onset", "contact", "balance", "separated"]
+    assert [name for _, name in forced.events] == ["onset", "contact", "balance", "jump_out",
+                                                   "separated"]
     nodes = forced.nodes
     assert not np.any(nodes.status[:nodes.n] == contact_state.CONTACT)
     assert forced.summary["t_separation"] == pytest.approx(free.summary["t_separation"],
@@ -528,7 +530,8 @@ def test_a_lost_balance_is_landed_on_from_as_far_in_time_at_every_level(monkeypa
     monkeypatch.setattr(contact_replay, "BALANCED_MARGIN", 1.0)
     scene = load_scene(CONFIGS / "compliant_machine.yaml", overrides=["model.until=separation"])
     level = contact.run_level(scene, 256)
-    assert [name for _, name in level.events] == ["onset", "contact", "balance", "separated"]
+    assert [name for _, name in level.events] == ["onset", "contact", "balance", "jump_out",
+                                                  "separated"]
     assert not level.notes
     ref = REFERENCE["compliant_machine"]
     assert level.summary["t_separation"] == pytest.approx(ref["t_separation"], rel=2e-7)  # 8.1e-8
@@ -548,7 +551,8 @@ def test_a_kelvin_voigt_bond_behind_a_soft_spring_runs_through_and_snaps_at_a_ze
     scene = load_scene(CONFIGS / "compliant_machine.yaml",
                        overrides=["model.until=separation", "loading.machine_stiffness=1"])
     level = contact.run_level(scene, 32)
-    assert [name for _, name in level.events] == ["onset", "contact", "balance", "separated"]
+    assert [name for _, name in level.events] == ["onset", "contact", "balance", "jump_out",
+                                                  "separated"]
     assert not level.notes
     for ours, theirs in (("t_separation", "t_separation"), ("F_peak_total", "F_peak_total")):
         assert level.summary[ours] == pytest.approx(ref[theirs], rel=1e-4), ours
