@@ -184,6 +184,71 @@ def test_force_controlled_kelvin_voigt_punch_still_comes_off():
     assert summary["F_pulloff"] == pytest.approx(0.1 * summary["t_separation"], rel=1e-9)
 
 
+def _kv_force_path(segments, n=32):
+    """``separation_kv.yaml`` under force control along ``segments`` (YAML), one level."""
+    scene = load_scene(CONFIGS / "separation_kv.yaml", overrides=[
+        "loading={kind: path, control: force, h0: 0.0, segments: [%s]}" % segments])
+    return contact.run_level(scene, n)
+
+
+def _bonded_gap_max(level):
+    rows = np.array(level.rows)
+    return rows[rows[:, 2] == 1.0][:, 4].max()
+
+
+def test_a_force_ramp_ends_on_its_target_force():
+    """A segment's end met in one step from below (a driven force, linear in the step's
+    length) is landed on: it was once landed a whole step late (the far end of the search's
+    bracket: at n = 32 the ramp to 1.25 mN ended at 12.648 ms, not 12.5, and the bonded punch
+    held with the gap at b above delta)."""
+    level = _kv_force_path("{force_rate: 0.1, until: {force: 1.25e-3}}, {hold: 0.05}")
+    ends = [t for t, name in level.events if name == "end"]
+    T = level.setup.T
+    assert ends[0] * T == pytest.approx(12.5e-3, rel=1e-12)
+    assert ends[1] * T == pytest.approx(62.5e-3, rel=1e-12)
+    assert _bonded_gap_max(level) <= 1.0 + 1e-12
+
+
+def test_the_first_of_two_events_in_one_step_is_landed_on():
+    """The ramp's end and the onset in one step, the end guessed first (linearly): once
+    landed on, the gap at b had passed delta, and the bonded punch went on past its onset
+    (n = 32 with the ramp to 1.26031 mN: the gap 1.0000058 delta, no onset). The onset that
+    crossed first is located inside the shorter step instead."""
+    level = _kv_force_path("{force_rate: 0.1, until: {force: 1.26031e-3}}, {hold: 0.002}")
+    names = [name for _, name in level.events]
+    assert names[:2] == ["onset", "end"]
+    assert _bonded_gap_max(level) <= 1.0 + 1e-12
+
+
+def test_a_held_edge_under_a_held_force_keeps_its_steps():
+    """Held just past the onset force, the crack recedes a little and arrests (the dashpots
+    relax toward the elastic solid, whose pull-off force is higher). Its edge, stuck, moves
+    by its roots' rounding only, which the crack-growth measure read as 0.5 to 20 e-folds a
+    step: the steps were redone down to 1e-11 of the time scale, the balance then failed on
+    rounding and the punch was reported off (n = 32, and that run then stopped with a
+    RuntimeError). The force ramped back to zero touches zero by rounding, which is no
+    compression."""
+    level = _kv_force_path("{force_rate: 0.1, until: {force: 1.2605e-3}}, {hold: 0.05}, "
+                           "{force_rate: -0.1, until: {force: 0.0}}")
+    assert [name for _, name in level.events] == ["onset", "end", "end", "end"]
+    assert not level.notes
+    assert math.isnan(level.summary["F_max_compressive"])
+
+
+def test_a_force_path_past_its_separation_ends_with_a_note():
+    """A free indenter carries no force: under force control the path ends at the
+    separation, with a note (a hold after it looped on its lost balance until the run
+    stopped with a RuntimeError); and a force or hold segment right after an ``until:
+    separation`` is refused before any work."""
+    level = _kv_force_path("{force_rate: 0.1, until: {force: 2.0e-3}}, {hold: 0.01}", n=16)
+    assert [name for _, name in level.events][-3:] == ["balance", "jump_out", "separated"]
+    assert [what for what, _ in level.notes] == ["free"]
+    with pytest.raises(SceneError, match=r"segments\[1\]\.hold = 0\.01: follows a separation"):
+        load_scene(CONFIGS / "separation_kv.yaml", overrides=[
+            "loading={kind: path, control: force, h0: 0.0, segments: "
+            "[{force_rate: 0.1, until: separation}, {hold: 0.01}]}"])
+
+
 @pytest.mark.parametrize("lam", [0.1, 0.3])
 def test_dmt_like_sphere_matches_maugis_dugdale_and_tends_to_dmt(lam):
     """Small lambda: the zone is born stable and grows (no jump in), the contact is lost

@@ -135,4 +135,12 @@ class Path(Kind):
         if self.machine_stiffness is not None and self.control == "force":
             raise bad_line(f"{{p}}machine_stiffness = {fmt(self.machine_stiffness)}: a spring "
                            "between driver and indenter only under control: displacement")
+        if self.control == "force":
+            for i, (seg, after) in enumerate(zip(self.segments, self.segments[1:])):
+                apart = seg.until is not None and seg.until.event == "separation"
+                if apart and after.speed is None:
+                    raise bad_line(f"{{p}}segments[{i + 1}].{after.drive} = "
+                                   f"{fmt(getattr(after, after.drive))}: follows a separation "
+                                   "under control: force, and a free indenter carries no force "
+                                   "(move it with speed: m/s)")
         return self

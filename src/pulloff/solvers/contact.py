@@ -141,6 +141,8 @@ def run_level(scene, n: int, setup=None, progress=None) -> Stepper:
 
 #: Outputs smaller than this share of their run's scale are judged against that share.
 FLOOR_SHARE = 1e-2
+#: A path's force within this share of its largest magnitude of zero is zero (rounding).
+_FORCE_ROUNDING = 1e-12
 
 
 def _floor(stepper) -> np.ndarray:
@@ -242,10 +244,14 @@ def _path_summary(stepper, rows, events) -> dict:
     i_max = int(np.argmax(Ft))
     i_min = int(np.argmin(Ft))
     tp, Fp = peak(t, Ft, stepper.kinks)
+    # A force that only touches zero from below by rounding (a force-controlled path back to
+    # F = 0) is no compression: its -0.0 on some levels and nan on others read as an event
+    # found on some levels only, and the ladder's estimate was infinite.
+    compressed = Ft[i_min] < -_FORCE_ROUNDING * np.max(np.abs(Ft))
     out = {"F_pulloff": Fp * s.F0, "t_pulloff": tp * s.T,
            "h_pulloff": float(np.interp(tp, t, H)) * s.delta if i_max in range(len(t)) else
            math.nan,
-           "F_max_compressive": min(Ft[i_min], 0.0) * s.F0 if Ft[i_min] < 0.0 else math.nan}
+           "F_max_compressive": Ft[i_min] * s.F0 if compressed else math.nan}
     for kind in ("in", "out"):
         when = [w for w, name in stepper.events if name == f"jump_{kind}"]
         if when:
@@ -324,11 +330,17 @@ def _notes(stepper, scene, estimate, rtol) -> list:
                          "stretch (a finer rtol may carry it through) or the crack arrests "
                          "(its edge would advance again, which this model does not follow); "
                          "no separation or peak is reported")
+        elif what == "free":
+            notes.append(f"came off at t = {t * s.T:.6g} s under force control: a free "
+                         "indenter carries no force, so the loading path ends there (what "
+                         "remains of it was not run)")
         elif what == "steps":
             notes.append(f"stopped at t = {t * s.T:.6g} s: {MAX_STEPS} steps in one run")
     if not estimate <= rtol and not getattr(stepper, "interrupted", False):
-        notes.append(f"not converged: error estimate {estimate:.2g} above rtol {rtol:g} at the "
-                     f"step cap ({MAX_STEPS} steps per level)")
+        why = ("the levels disagree on which events occur (each found by some only is "
+               "reported as the finest level has it)" if math.isinf(estimate) else
+               f"error estimate {estimate:.2g} above rtol {rtol:g}")
+        notes.append(f"not converged: {why}, at the step cap ({MAX_STEPS} steps per level)")
     return notes
 
 
