@@ -8,6 +8,7 @@ limit, and the flat punch's existing scenes for the flat punch driven through a 
 
 import functools
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -322,6 +323,22 @@ def test_kelvin_voigt_under_a_sphere_is_refused_before_work():
     with pytest.raises(SceneError) as info:
         path_scene(10.0, material={"kind": "kelvin_voigt", "G": 1e6, "eta": 1e3})
     assert "material.kind" in str(info.value) and "instantaneous" in str(info.value)
+
+
+@pytest.mark.parametrize("loading, key", [
+    ("{kind: path, h0: %r, segments: [{speed: -1.0e-6, until: {force: -2.0e-6}}, "
+     "{speed: 1.0e-6, until: separation}]}" % h0, "loading.h0 = ")
+    for h0 in (0.5e-8, 0.0, -1e-8)] + [
+    ("{kind: path, control: force, h0: 2.0e-8, segments: [{force_rate: -1.0e-6, until: "
+     "{force: -2.0e-6}}, {force_rate: 1.0e-6, until: separation}]}",
+     "loading.segments[0].force_rate = ")])
+def test_a_smooth_indenter_that_does_not_start_apart_is_refused_before_work(loading, key):
+    """A smooth indenter starts apart with no zone: from within the adhesive range (delta =
+    1e-8 m here) or pressed in it once ran with neither a zone nor a contact and reported a
+    pull-off of 0; a force segment first under force control (a free indenter carries no
+    force) stopped with a RuntimeError at t = 0."""
+    with pytest.raises(SceneError, match=re.escape(key)):
+        load_scene(CONFIGS / "sphere_elastic.yaml", overrides=[f"loading={loading}"])
 
 
 def _sls_sphere(tau, speed=1e-6, hold=None, n=16, G_1=9e6):

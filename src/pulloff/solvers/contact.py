@@ -73,6 +73,25 @@ class ContactSolver(Solver):
                 "material.kind", scene.material.kind, f"a {scene.geometry.kind} on a "
                 "Kelvin-Voigt solid is not solved (its jump into contact has no instantaneous "
                 "response); use a standard linear solid with a stiff, fast arm"))
+        delta = scene.adhesion.delta
+        if (scene.geometry.kind != "flat_punch" and scene.loading.kind == "path"
+                and not scene.loading.h0 > delta):
+            # The stepper starts a smooth indenter apart with no zone: from within the zone's
+            # range (or pressed in) it ran without a zone or a contact, and reported a
+            # pull-off of 0 (measured at h0 = 0.5 delta, 0 and -delta on sphere_elastic).
+            out.append(problem_line(
+                "loading.h0", scene.loading.h0, f"a smooth indenter starts apart, beyond the "
+                f"adhesive range: h0 must exceed delta = {delta:.6g} m (press it in with a "
+                "speed segment)"))
+        if (scene.geometry.kind != "flat_punch" and scene.loading.kind == "path"
+                and scene.loading.control == "force" and scene.loading.segments[0].speed is None):
+            # A smooth indenter starts free, and a free indenter carries no force (these ended
+            # at t = 0 in a RuntimeError, then with a note).
+            first = scene.loading.segments[0]
+            out.append(problem_line(
+                f"loading.segments[0].{first.drive}", getattr(first, first.drive), "under "
+                "control: force a smooth indenter starts apart and carries no force: bring it "
+                "into contact first with a speed segment (speed: m/s)"))
         machine = getattr(scene.loading, "machine_stiffness", None)
         if (machine is not None and scene.model.until == "separation"
                 and scene.material.spectrum().arms
