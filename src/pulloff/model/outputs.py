@@ -65,7 +65,7 @@ OUTPUTS = (
     _s("zone_ratio_detach", "1", "(b - a)/a at the onset"),
     _s("F_contact_detach", "N", "F_contact at the onset (the seed's pull-off force, eq. 48)"),
     _s("F_total_detach", "N", "F_total at the onset"),
-    _s("t_separation", "s", "complete separation: the zone has vanished", "separation"),
+    _s("t_separation", "s", "the first complete separation: the zone has vanished", "separation"),
     _s("F_peak_contact", "N", "largest F_contact of the run", "separation"),
     _s("F_peak_total", "N", "largest F_total of the run (the pull-off force)", "separation"),
     _s("t_peak_contact", "s", "time of the largest F_contact (not error-controlled: the time "
@@ -77,10 +77,10 @@ OUTPUTS = (
                          "maximum is ill-conditioned)", "path"),
     _s("t_pulloff", "s", "time of F_pulloff (not error-controlled, likewise)", "path"),
     _s("F_max_compressive", "N", "the most compressive F_total of the path (negative)", "path"),
-    _s("F_jump_in", "N", "F_total just before the surface jumps into contact", "jump"),
-    _s("h_jump_in", "m", "lift where the surface jumps into contact", "jump"),
-    _s("F_jump_out", "N", "F_total just before the contact is lost by a jump", "jump"),
-    _s("h_jump_out", "m", "lift where the contact is lost by a jump", "jump"),
+    _s("F_jump_in", "N", "F_total just before the surface first jumps into contact", "jump"),
+    _s("h_jump_in", "m", "lift where the surface first jumps into contact", "jump"),
+    _s("F_jump_out", "N", "F_total just before the contact is first lost by a jump", "jump"),
+    _s("h_jump_out", "m", "lift where the contact is first lost by a jump", "jump"),
     _s("energy_dissipated", "J", "int F_total dh over the whole path: the machine's net work, "
                                  "the energy lost over a closed cycle", "path"),
     _s("work_separation", "J", "int max(F_total, 0) dh over the last retraction: the work "
