@@ -982,37 +982,7 @@ class Stepper:
         if what == "advance":
             return self._jump("in")
         if what in ("separation", "zone", "balance"):
-            if what in ("zone", "balance") and now.alpha == 0.0 and self._growing_zone():
-                # (behind a spring the zone's lost branch shows as a lost balance)
-                self._touch()
-                return self._jump("in")
-            if (what == "balance" and now.alpha > 0.0 and now.phase == st.CONTACT_PHASE
-                    and self.setup.law.c > 0.0 and self.setup.machine is not None):
-                return self._arrest()
-            if what == "balance":
-                # No equilibrium under the spring or the force: the indenter snaps off (the
-                # zone alone too: its force drops to zero at once); a bond that had held until
-                # then fails in that instant (its onset).
-                if now.phase in (st.BONDED, st.PINNED) and not any(
-                        name == "onset" for _, name in self.events):
-                    self.events.append((now.t, "onset"))
-                self.events.append((now.t, "jump_out"))
-            if what == "zone" and not self._at_limit("zone"):
-                # A zone alone whose branch folds while it still pulls (a DMT-like sphere's
-                # last zone): the force drops to zero at once, a jump.
-                self.events.append((now.t, "jump_out"))
-            now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
-            self.events.append((now.t, "separated"))
-            self._row(now)
-            if self.setup.until == "detach" and any(n == "onset" for _, n in self.events):
-                return self._physical_end("onset")
-            self._physical_end("separation")
-            if now.phase != st.DONE and not self.lift_driven and self.setup.machine is None:
-                # A free punch carries no force: a path under force control cannot go on (a
-                # hold past the separation looped on its lost balance until the run stopped).
-                self.notes.append(("free", now.t))
-                now.phase = st.DONE
-            return
+            return self._branch_lost(what)
         if what == "birth":
             now.phase = st.ZONE
             return
@@ -1023,6 +993,42 @@ class Stepper:
         if what.startswith("knot_"):
             return
         raise RuntimeError(f"unknown event {what!r}")  # a bug, not input
+
+    def _branch_lost(self, what) -> None:
+        """The separation, or the end of the zone's or the force balance's branch: a jump
+        into contact (an approach), an arrest behind a spring, or the indenter off."""
+        now = self.now
+        if what in ("zone", "balance") and now.alpha == 0.0 and self._growing_zone():
+            # (behind a spring the zone's lost branch shows as a lost balance)
+            self._touch()
+            return self._jump("in")
+        if (what == "balance" and now.alpha > 0.0 and now.phase == st.CONTACT_PHASE
+                and self.setup.law.c > 0.0 and self.setup.machine is not None):
+            return self._arrest()
+        if what == "balance":
+            # No equilibrium under the spring or the force: the indenter snaps off (the zone
+            # alone too: its force drops to zero at once); a bond that had held until then
+            # fails in that instant (its onset).
+            if now.phase in (st.BONDED, st.PINNED) and not any(
+                    name == "onset" for _, name in self.events):
+                self.events.append((now.t, "onset"))
+            self.events.append((now.t, "jump_out"))
+        if what == "zone" and not self._at_limit("zone"):
+            # A zone alone whose branch folds while it still pulls (a DMT-like sphere's last
+            # zone): the force drops to zero at once, a jump.
+            self.events.append((now.t, "jump_out"))
+        now.phase, now.alpha, now.beta = st.APART, 0.0, 0.0
+        self.events.append((now.t, "separated"))
+        self._row(now)
+        if self.setup.until == "detach" and any(n == "onset" for _, n in self.events):
+            return self._physical_end("onset")
+        self._physical_end("separation")
+        if now.phase != st.DONE and not self.lift_driven and self.setup.machine is None:
+            # A free indenter carries no force: a path under force control cannot go on (a
+            # hold past the separation looped on its lost balance until the run stopped).
+            self.notes.append(("free", now.t))
+            now.phase = st.DONE
+        return None
 
     def _growing_zone(self) -> bool:
         """Whether a zone-only branch ended while the zone grew or was just born (an approach:
