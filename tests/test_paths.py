@@ -325,6 +325,26 @@ def test_kelvin_voigt_under_a_sphere_is_refused_before_work():
     assert "material.kind" in str(info.value) and "instantaneous" in str(info.value)
 
 
+@pytest.mark.parametrize("segments, events", [
+    ("{speed: -1.0e-6, until: {lift: 1.5e-8}}, {force_rate: 1.0e-6, until: separation}",
+     ["end"]),
+    ("{speed: -1.0e-6, until: {force: -2.0e-6}}, {speed: 1.0e-6, until: {lift: 1.0e-6}}, "
+     "{force_rate: 1.0e-6, until: {force: 1.0e-6}}", ["jump_out", "separated", "end"]),
+    ("{speed: -1.0e-6, until: {force: -2.0e-6}}, {speed: 1.0e-6, until: {lift: 1.0e-6}}, "
+     "{hold: 0.01}", ["jump_out", "separated", "end"])])
+def test_a_force_or_hold_segment_reached_apart_ends_the_path_with_a_note(segments, events):
+    """Under force control an indenter apart carries no force, so a force or hold segment
+    that begins apart ends the path. Before: an approach that never touched recorded a jump
+    out and a separation (F_jump_out = 0); a force ramp after a retraction to 1 um stopped
+    with a RuntimeError; a hold there moved the indenter on at its last speed."""
+    scene = load_scene(CONFIGS / "sphere_elastic.yaml", overrides=[
+        "loading={kind: path, control: force, h0: 2.0e-8, segments: [%s]}" % segments])
+    level = contact.run_level(scene, 16)
+    assert [name for _, name in level.events][-len(events):] == events
+    assert [what for what, _ in level.notes] == ["free"]
+    assert level.segment == len(scene.loading.segments) - 1
+
+
 @pytest.mark.parametrize("loading, key", [
     ("{kind: path, h0: %r, segments: [{speed: -1.0e-6, until: {force: -2.0e-6}}, "
      "{speed: 1.0e-6, until: separation}]}" % h0, "loading.h0 = ")

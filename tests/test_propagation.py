@@ -310,12 +310,12 @@ def test_the_zone_alone_holds_the_face_until_the_rim_opens(machine):
     assert events["release"] == pytest.approx(events["strength"] + 1.0 - gap, rel=1e-12)
     # The extrapolated answer, against the finest level's history (their difference is the
     # extrapolation's correction: measured 6.2e-9 and 2.9e-8, the estimates 8.6e-6 and
-    # 1.4e-5).
+    # 1.4e-5; 1.5e-9 and 1.2e-9 while a coarse level's event could land a step late).
     res = solvers.simulate(scene)
     h = res.history
     at_limit = int(np.argmax(h["t"] >= res.t_detach))
     opens = res.t_detach + (3e-6 - h["gap"][at_limit]) / 1e-3
-    assert abs(res.t_separation / opens - 1.0) <= res.error_estimate
+    assert abs(res.t_separation / opens - 1.0) <= 1e-7
     assert res.F_total_detach == pytest.approx(math.pi * 1e-10 * 1e6, rel=1e-12)
 
 

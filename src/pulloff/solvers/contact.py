@@ -350,7 +350,7 @@ def _notes(stepper, scene, estimate, rtol) -> list:
                          "(its edge would advance again, which this model does not follow); "
                          "no separation or peak is reported")
         elif what == "free":
-            notes.append(f"came off at t = {t * s.T:.6g} s under force control: a free "
+            notes.append(f"apart at t = {t * s.T:.6g} s under force control: a free "
                          "indenter carries no force, so the loading path ends there (what "
                          "remains of it was not run)")
         elif what == "steps":

@@ -530,14 +530,17 @@ class Stepper:
         if ev is None and driven:
             return False  # (finite_punch_internal at n = 8: its zone-alone phase; stepped to)
         if ev is None:
-            # No zone-alone state balances the spring at a = 0 (measured: the punch lets go
-            # there, the reference's "snap_at_a_zero"). The bond's elements go free with
-            # their state now; they would relax unloaded for the short landing.
+            # No zone-alone state balances the spring (or the driven force) at a = 0
+            # (measured: the punch lets go there, the reference's "snap_at_a_zero"). The
+            # bond's elements go free with their state now; they would relax unloaded for the
+            # short landing.
             zone = self._last_quadratic(3)  # the zone end stays smooth: b ~ b0 + c (t0 - t)
             beta = float(np.polyval(zone[1], t_end - zone[0])) if zone else now.beta
+            force = math.pi * beta ** 2
+            if self.setup.machine is None:  # under force control: the force driven then
+                force = now.F_total + self._force_rate() * (t_end - now.t)
             self._release_all()
-            self._land(t_end, "contact", alpha=0.0, beta=beta, F_contact=0.0,
-                       F_total=math.pi * beta ** 2)
+            self._land(t_end, "contact", alpha=0.0, beta=beta, F_contact=0.0, F_total=force)
             return True
         self.commit(step, ev)
         self.transition("contact")
@@ -726,10 +729,12 @@ class Stepper:
                 hi, f_hi = d, abs(f_hi)  # the branch ends before: the event is earlier
                 last_lost = lost
                 continue
-            if abs(f) <= 1e-13:
-                # On the event to rounding, from either side. (The far end of the bracket was
-                # taken here once: a target met in one step from below, as a driven force
-                # meets its segment's end, then ended that segment a whole step late.)
+            if 0.0 <= f <= 1e-13:
+                # On the event, to rounding, on its far side (an event landed short of it
+                # would cross again). Converged from below, the search goes on until the
+                # bracket closes: it once stopped there and took the bracket's far end, and a
+                # target met in one step from below (a driven force meeting its segment's
+                # end) ended its segment a whole step late.
                 return cache[d]
             if f >= 0.0:
                 hi, f_hi = d, f
@@ -801,10 +806,10 @@ class Stepper:
 
     def _at_limit(self, what, now=None) -> bool:
         """Whether the state (now, or an evaluation) is at the natural end of its branch: the
-        edge at the centre, the zone gone, or a flat punch's zone alone under a rising force
-        (it pulls with ``sigma_c pi b^2`` and cannot grow, its broken bonds do not re-form:
-        no state carries more than it does now; located as a fold and then bisected, the end
-        took 4.3 s of a 5.1 s level)."""
+        edge at the centre, the zone gone, or (whatever the state) a flat punch's zone alone
+        under a rising force (it pulls with ``sigma_c pi b^2`` and cannot grow, its broken
+        bonds do not re-form: no state carries more than it does now; located as a fold and
+        then bisected, the end took 4.3 s of a 5.1 s level)."""
         now = now or self.now
         # A sliver this thin released at once changes the gap by ~(sliver)^2.
         if what == "contact":
@@ -998,6 +1003,9 @@ class Stepper:
         """The separation, or the end of the zone's or the force balance's branch: a jump
         into contact (an approach), an arrest behind a spring, or the indenter off."""
         now = self.now
+        if now.phase == st.APART:  # (never touched, or apart already: nothing comes off)
+            self._free_under_force()
+            return None
         if what in ("zone", "balance") and now.alpha == 0.0 and self._growing_zone():
             # (behind a spring the zone's lost branch shows as a lost balance)
             self._touch()
@@ -1023,11 +1031,10 @@ class Stepper:
         if self.setup.until == "detach" and any(n == "onset" for _, n in self.events):
             return self._physical_end("onset")
         self._physical_end("separation")
-        if now.phase != st.DONE and not self.lift_driven and self.setup.machine is None:
-            # A free indenter carries no force: a path under force control cannot go on (a
-            # hold past the separation looped on its lost balance until the run stopped).
-            self.notes.append(("free", now.t))
-            now.phase = st.DONE
+        if now.phase != st.DONE:
+            # Off inside a segment that drives the force: the path cannot go on (a hold past
+            # the separation looped on its lost balance until the run stopped).
+            self._free_under_force()
         return None
 
     def _growing_zone(self) -> bool:
@@ -1146,7 +1153,25 @@ class Stepper:
             self.now.phase = st.DONE
             return
         self.segment += 1
+        if self._free_under_force():
+            return
         self._begin_segment()
+
+    def _free_under_force(self) -> bool:
+        """End the run where an indenter apart would have to carry a driven force (a force
+        or hold segment under force control): a free indenter carries none. (A hold after a
+        speed segment that ended apart moved it on at its last speed; a force segment
+        there stopped with a RuntimeError.)"""
+        if (self.now.phase != st.APART or self.lift_driven
+                or self.setup.machine is not None):
+            return False
+        self.notes.append(("free", self.now.t))
+        self.now.phase = st.DONE
+        return True
+
+    def _force_rate(self) -> float:
+        drive = self.drive
+        return drive.rate if drive.kind == "force_rate" else 0.0
 
     def _begin_segment(self) -> None:
         now = self.now
