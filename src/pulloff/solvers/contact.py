@@ -74,8 +74,8 @@ class ContactSolver(Solver):
                 "Kelvin-Voigt solid is not solved (its jump into contact has no instantaneous "
                 "response); use a standard linear solid with a stiff, fast arm"))
         delta = scene.adhesion.delta
-        if (scene.geometry.kind != "flat_punch" and scene.loading.kind == "path"
-                and not scene.loading.h0 > delta):
+        smooth_path = scene.geometry.kind != "flat_punch" and scene.loading.kind == "path"
+        if smooth_path and not scene.loading.h0 > delta:
             # The stepper starts a smooth indenter apart with no zone: from within the zone's
             # range (or pressed in) it ran without a zone or a contact, and reported a
             # pull-off of 0 (measured at h0 = 0.5 delta, 0 and -delta on sphere_elastic).
@@ -83,8 +83,8 @@ class ContactSolver(Solver):
                 "loading.h0", scene.loading.h0, f"a smooth indenter starts apart, beyond the "
                 f"adhesive range: h0 must exceed delta = {delta:.6g} m (press it in with a "
                 "speed segment)"))
-        if (scene.geometry.kind != "flat_punch" and scene.loading.kind == "path"
-                and scene.loading.control == "force" and scene.loading.segments[0].speed is None):
+        if (smooth_path and scene.loading.control == "force"
+                and scene.loading.segments[0].speed is None):
             # A smooth indenter starts free, and a free indenter carries no force (these ended
             # at t = 0 in a RuntimeError, then with a note).
             first = scene.loading.segments[0]

@@ -165,6 +165,12 @@ class Stepper:
         return self.setup.machine is None and (self.setup.control == "displacement"
                                                or self.drive.kind == "speed")
 
+    @property
+    def force_driven(self) -> bool:
+        """Whether the force is prescribed (under force control, no speed segment): the lift
+        follows it."""
+        return not self.lift_driven and self.setup.machine is None
+
     # --- start -------------------------------------------------------------------------------
     def _start(self) -> st.Instant:
         s = self.setup
@@ -537,7 +543,7 @@ class Stepper:
             zone = self._last_quadratic(3)  # the zone end stays smooth: b ~ b0 + c (t0 - t)
             beta = float(np.polyval(zone[1], t_end - zone[0])) if zone else now.beta
             force = math.pi * beta ** 2
-            if self.setup.machine is None:  # under force control: the force driven then
+            if self.force_driven:  # the force driven then
                 force = now.F_total + self._force_rate() * (t_end - now.t)
             self._release_all()
             self._land(t_end, "contact", alpha=0.0, beta=beta, F_contact=0.0, F_total=force)
@@ -619,7 +625,7 @@ class Stepper:
         if s.machine is not None:
             driver = now.driver + drive.rate * dt
             return lambda ev: s.machine * (driver - ev.H) - ev.F_total
-        target = now.F_total + (drive.rate * dt if drive.kind == "force_rate" else 0.0)
+        target = now.F_total + self._force_rate() * dt
         return lambda ev: target - ev.F_total
 
     def _balanced(self, step) -> Evaluation:
@@ -817,10 +823,7 @@ class Stepper:
         if what == "zone":  # a vanishing zone, not one being born
             return now.beta <= 1e-6 and not self._growing_zone()
         if what == "balance":
-            drive = self.drive
-            return (self.setup.flat and self.now.phase == st.ZONE and not self.lift_driven
-                    and self.setup.machine is None and drive.kind == "force_rate"
-                    and drive.rate > 0.0)
+            return self.setup.flat and self.now.phase == st.ZONE and self._force_rate() > 0.0
         return False
 
     # --- committing a step ---------------------------------------------------------------------
@@ -1162,8 +1165,7 @@ class Stepper:
         or hold segment under force control): a free indenter carries none. (A hold after a
         speed segment that ended apart moved it on at its last speed; a force segment
         there stopped with a RuntimeError.)"""
-        if (self.now.phase != st.APART or self.lift_driven
-                or self.setup.machine is not None):
+        if self.now.phase != st.APART or not self.force_driven:
             return False
         self.notes.append(("free", self.now.t))
         self.now.phase = st.DONE
