@@ -626,8 +626,12 @@ def _cohesive_bracket(S):
     small = S < _COH_SERIES_MAX_S
     if small.all():  # (a thin zone's whole history: no masks)
         return _cohesive_series(S)
+    # math.atan, not np.arctan: numpy's vectorised arctan may round differently in the last
+    # bit (it did on an Intel Xeon, not on an AMD EPYC), and a history's row must be the
+    # scalar path's value whatever the machine.
+    atan = np.array([math.atan(s) for s in S.ravel().tolist()]).reshape(S.shape)
     with np.errstate(over="ignore", invalid="ignore"):
-        out = (1.0 + S * S) * np.arctan(S) - S
+        out = (1.0 + S * S) * atan - S
     if small.any():
         out[small] = _cohesive_series(S[small])
     return out
