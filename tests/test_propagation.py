@@ -702,7 +702,7 @@ def test_a_prony_punchs_zone_alone_is_not_lost_to_the_landing_on_a_zero(monkeypa
 
 @pytest.mark.parametrize("config,n,edges,zones", [
     ("sls_finite_punch", 16, 20, 5), ("prony_external", 16, 20, 5),
-    ("separation_kv", 16, 20, 5), ("sphere_sls_cycle", 8, 150, 1)])
+    ("separation_kv", 16, 20, 5), ("sphere_sls_cycle", 8, 150, 0)])
 def test_the_compiled_secants_take_the_python_secants_steps(monkeypatch, config, n, edges,
                                                             zones):
     """A receding flat punch's edge and a zone end are found by secant iterations compiled
@@ -712,7 +712,9 @@ def test_the_compiled_secants_take_the_python_secants_steps(monkeypatch, config,
     linear solid, two Prony arms and Kelvin-Voigt to separation, and a standard linear
     solid's sphere through its cycle, jumps included, its smooth edge compiled since the
     twelfth session: 204 searches at n = 8). ``edges``, ``zones``: at least this many
-    compiled searches found their root (the Kelvin-Voigt punch's edge 37 times)."""
+    compiled searches found their root (the Kelvin-Voigt punch's edge 37 times; the sphere's
+    one zone search was a fallback of its contact phase's balance, which since the sixteenth
+    session converges from the last step's Jacobian)."""
     overrides = [] if config.startswith("sphere") else ["model.until=separation"]
     scene = load_scene(CONFIGS / f"{config}.yaml", overrides=overrides)
     found = []
