@@ -964,3 +964,43 @@ def test_the_secant_from_the_nearest_root_finds_a_smooth_root_and_gives_way_else
     assert abs(d - root) <= 1e-14 * root
     assert contact_fold._secant_from([], x, residual, 1e-12, 1.0) is None
     assert contact_fold._secant_from(found, x, residual, 1e-12, 0.5 * root) is None
+
+
+def _counted(residual):
+    calls = []
+
+    def counted(z):
+        calls.append(z.copy())
+        return residual(z)
+    return counted, calls
+
+
+def test_a_remembered_jacobian_solves_a_linear_balance_in_one_step_and_a_stale_one_is_refused():
+    """contact_balance._remembered_jacobian: with the exact Jacobian a linear balance takes
+    two evaluations (the start and the root); one changing by more than
+    ``_JACOBIAN_CHANGE`` on the way (a fold's Jacobian turning singular) or none at all is
+    handed to Newton (None); a nonlinear balance from a Jacobian 5 % off converges to the
+    tolerance."""
+    from pulloff.solvers import contact_balance as cb
+
+    A = np.array([[4e-4, 2.4e-2], [-5.6e-5, -5.1e-3]])  # (a receding edge's, scaled)
+    root = np.array([0.98, 3.2])
+    scale, rscale = np.array([1e-4, 1e-6]), np.array([1.0, 1.0])
+
+    def linear(z):
+        return "ev", A @ (z - root)
+    counted, calls = _counted(linear)
+    (ev, r), J = cb._remembered_jacobian(counted, root + [1e-3, 1e-5], A, scale, rscale)
+    assert len(calls) == 2 and np.all(np.abs(r) <= 1e-12)
+    np.testing.assert_allclose(calls[-1], root, rtol=1e-12)
+    assert cb._remembered_jacobian(linear, root + [1e-3, 1e-5], None, scale, rscale) is None
+    assert cb._remembered_jacobian(linear, root + [1e-3, 1e-5], 1.5 * A, scale, rscale) is None
+
+    def curved(z):
+        return "ev", np.array([z[0] ** 3 - 8.0, z[0] + 2.0 * z[1] - 4.0])
+    J0 = np.array([[12.0 * 1.05, 0.0], [1.0, 2.0]])
+    counted, calls = _counted(curved)
+    (ev, r), J = cb._remembered_jacobian(counted, np.array([2.01, 1.0]), J0, np.ones(2),
+                                         np.ones(2))
+    assert np.all(np.abs(r) <= 1e-12) and len(calls) <= 6
+    np.testing.assert_allclose(calls[-1], [2.0, 1.0], rtol=1e-12)
