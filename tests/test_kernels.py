@@ -368,7 +368,7 @@ def test_free_gap_integral_extrapolates_the_end_value_from_beyond_a_kink():
     n = xi.size
     given_end = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], 1.0, kink)
     beyond = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan, kink)
-    across = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan)
+    across = C.free_gap_integral(xi, U, 0, n, 0.0, beta, U[0], math.nan, 0.0)
     assert beyond == pytest.approx(given_end, rel=1e-13)
     assert abs(across - given_end) > 1e-4 * abs(given_end)
 
@@ -399,7 +399,7 @@ def test_free_gap_integral_keeps_its_fourth_order_across_a_kink():
             U = field(np.arccos(xi / beta))
             args = (xi, U, 0, nodes, 0.0, beta, float(field(0.5 * math.pi)), float(field(0.0)))
             split.append(abs(C.free_gap_integral(*args, kink) - exact))
-            across.append(abs(C.free_gap_integral(*args) - exact))
+            across.append(abs(C.free_gap_integral(*args, 0.0) - exact))
         assert split[0] / split[1] > 10.0 and split[1] / split[2] > 10.0, (offset, split)
         assert across[-1] > 100.0 * split[-1], (offset, split, across)
 
