@@ -995,6 +995,11 @@ def test_a_remembered_jacobian_solves_a_linear_balance_in_one_step_and_a_stale_o
     np.testing.assert_allclose(calls[-1], root, rtol=1e-12)
     assert cb._remembered_jacobian(linear, root + [1e-3, 1e-5], None, scale, rscale) is None
     assert cb._remembered_jacobian(linear, root + [1e-3, 1e-5], 1.5 * A, scale, rscale) is None
+    # A nearly singular one would step to absurd values (a trial there does not return).
+    counted, calls = _counted(linear)
+    assert cb._remembered_jacobian(counted, root + [1e-3, 1e-5], 1e-12 * A, scale,
+                                   rscale) is None
+    assert len(calls) == 1
 
     def curved(z):
         return "ev", np.array([z[0] ** 3 - 8.0, z[0] + 2.0 * z[1] - 4.0])

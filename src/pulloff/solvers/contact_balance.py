@@ -182,6 +182,12 @@ def _nested(stepper, step, H_guess, force_residual, H_travel):
 _JACOBIAN_CHANGE = 0.1
 
 
+#: A Broyden step this many times the unknown's size (or its scale, if larger) is none:
+#: a nearly singular remembered Jacobian would send the evaluation to lifts of 1e300, where
+#: a trial step does not return (found by a review; not met in any run).
+_FAR = 10.0
+
+
 def _remembered_jacobian(residual, z0, J, scale, rscale, tol=1e-12, max_iter=8):
     """Broyden iterations (secant iterations for one unknown) from the Jacobian the last
     solve of the same kind ended with: ``((evaluation, residual), Jacobian)``, or None
@@ -199,8 +205,9 @@ def _remembered_jacobian(residual, z0, J, scale, rscale, tol=1e-12, max_iter=8):
             if np.all(np.abs(r) <= tol * rscale):
                 return (ev, r), J
             dz = np.linalg.solve(J, -r)
-            if np.all(z + dz == z):
-                return None
+            if np.all(z + dz == z) or np.any(np.abs(dz) > _FAR * np.maximum(
+                    np.abs(scale), np.maximum(np.abs(z), 1.0))):
+                return None  # (no move, or one beyond any state of the branch)
             ev1, r1 = residual(z + dz)
             if not np.linalg.norm(r1 / rscale) < np.linalg.norm(r / rscale):
                 return None
