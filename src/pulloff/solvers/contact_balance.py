@@ -1,6 +1,7 @@
 """Machine spring and force control: the lift at the end of a step is one more unknown, with
-the force balance as one more condition; damped Newton on both (a finite-difference Jacobian:
-the unknowns are few, each evaluation advances every element)."""
+the force balance as one more condition. Broyden iterations from the Jacobian the step
+before ended with, else damped Newton with a finite-difference Jacobian (the unknowns are
+few, each evaluation advances every element)."""
 
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
     state of the branch: ``Lost("balance")``. Behind a soft spring past a fold (a tip's knot
     landed on within 1e-11 of the time, behind 1 N/m) the balance was met on the unstable
     side of the branch, three such instants walked the lift from 7.8 to 12.1 (scaled) at
-    one time, and the punch was reported off 0.1 % later and 1.3 % below its peak force;
+    one time, and the punch was reported off 0.1 % later and 1.5 % below its peak force;
     the branch's end there is a jump out."""
     ev = _solve(stepper, step, H_guess, force_residual, H_travel)
     now = step.now
@@ -37,11 +38,12 @@ def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
 def _solve(stepper, step, H_guess, force_residual, H_travel=0.0):
     """The evaluation whose lift balances ``force_residual`` and whose phase conditions hold.
 
-    Where the phase fixes its edges explicitly (bonded, pinned, apart) this is Newton on the
-    lift alone. Elsewhere the phase's own root finding runs inside a bracketed search on the
-    lift; a flat punch's edge is first tried held (the edge sticks while the gap stays below
-    delta), and that lift starts the search if it does not. ``H_travel`` is the lift's
-    expected travel over the step (it sizes the search's first trial)."""
+    Where the phase fixes its edges explicitly (bonded, pinned, apart) the lift is the only
+    unknown. In contact the edge and the lift are solved together (a flat punch's edge is
+    first tried held: it sticks while the gap stays below delta, and that lift starts the
+    receding edge's solve if it does not). Where these fail, the phase's own root finding
+    runs inside a bracketed search on the lift. ``H_travel`` is the lift's expected travel
+    over the step (it sizes the search's first trial)."""
     now = step.now
     explicit = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.FACE: phases.face,
                 st.APART: phases.apart}
@@ -81,7 +83,7 @@ def _solve(stepper, step, H_guess, force_residual, H_travel=0.0):
 
 def _lift_alone(stepper, key, build, H_guess, H_scale, force_residual, scale):
     """The evaluation of ``build(H)`` whose lift balances ``force_residual``, or None: secant
-    iterations from the slope the last such solve (``key``) ended with, else Newton."""
+    iterations from the slope the last solve of kind ``key`` ended with, else Newton."""
     def lifted(z):
         return _with_force(build(z[0]), force_residual)
 
