@@ -1000,6 +1000,10 @@ def test_a_remembered_jacobian_solves_a_linear_balance_in_one_step_and_a_stale_o
     assert cb._remembered_jacobian(counted, root + [1e-3, 1e-5], 1e-12 * A, scale,
                                    rscale) is None
     assert len(calls) == 1
+    # And Newton does not try such a step either (only the start and its finite difference).
+    counted, calls = _counted(lambda z: ("ev", 1e-3 * (z - 1e9)))
+    assert cb._newton(counted, np.array([1.0]), np.array([1e3]), np.array([1.0])) is None
+    assert max(abs(z[0]) for z in calls) < 2.0
 
     def curved(z):
         return "ev", np.array([z[0] ** 3 - 8.0, z[0] + 2.0 * z[1] - 4.0])

@@ -252,7 +252,9 @@ def _newton(residual, z0, scale, rscale, jacobians=None, tol=1e-12, max_iter=30)
         except np.linalg.LinAlgError:
             return None
         norm = np.linalg.norm(r / rscale)
-        lam = 1.0
+        # (no trial beyond any state of the branch: see _FAR)
+        reach = _FAR * np.maximum(np.abs(scale), np.maximum(np.abs(z), 1.0))
+        lam = min(1.0, float(np.min(reach / np.maximum(np.abs(dx), 1e-300))))
         while lam > 1.0 / 1024:
             try:
                 ev_t, r_t = residual(z + lam * dx)
