@@ -20,6 +20,11 @@ _INSTANT = 1e-9
 _FINITE_MOVE = 1e-4
 
 
+#: The phases whose edges follow explicitly from the lift: it is their only unknown.
+_EXPLICIT = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.FACE: phases.face,
+             st.APART: phases.apart}
+
+
 def solve(stepper, step, H_guess, force_residual, H_travel=0.0):
     """:func:`_solve`, where a state a finite lift away from the last in an instant is no
     state of the branch: ``Lost("balance")``. Behind a soft spring past a fold (a tip's knot
@@ -45,15 +50,13 @@ def _solve(stepper, step, H_guess, force_residual, H_travel=0.0):
     runs inside a bracketed search on the lift. ``H_travel`` is the lift's expected travel
     over the step (it sizes the search's first trial)."""
     now = step.now
-    explicit = {st.BONDED: phases.bonded, st.PINNED: phases.pinned, st.FACE: phases.face,
-                st.APART: phases.apart}
     scale = _force_scale(stepper, now)
     # Finite differences on the lift's own scale over the step: a viscous solid's force is
     # nonlinear in the lift on the scale of the rate it implies (a unit-sized difference put
     # the slope 6x off in a 3 ns first step, and Newton stalled).
     H_scale = np.array([max(H_travel, 1e-6 * abs(now.H), 1e-12)])
-    if now.phase in explicit:
-        build = explicit[now.phase]
+    if now.phase in _EXPLICIT:
+        build = _EXPLICIT[now.phase]
         out = _lift_alone(stepper, now.phase, lambda H: build(step, H), H_guess, H_scale,
                           force_residual, scale)
         if out is None:
@@ -190,6 +193,12 @@ _JACOBIAN_CHANGE = 0.1
 _FAR = 10.0
 
 
+def _reach(z, scale):
+    """The farthest a trial may move each unknown from ``z``: :data:`_FAR` times its size (at
+    least 1) or its ``scale``, whichever is larger."""
+    return _FAR * np.maximum(np.abs(scale), np.maximum(np.abs(z), 1.0))
+
+
 def _remembered_jacobian(residual, z0, J, scale, rscale, tol=1e-12, max_iter=8):
     """Broyden iterations (secant iterations for one unknown) from the Jacobian the last
     solve of the same kind ended with: ``((evaluation, residual), Jacobian)``, or None
@@ -207,8 +216,7 @@ def _remembered_jacobian(residual, z0, J, scale, rscale, tol=1e-12, max_iter=8):
             if np.all(np.abs(r) <= tol * rscale):
                 return (ev, r), J
             dz = np.linalg.solve(J, -r)
-            if np.all(z + dz == z) or np.any(np.abs(dz) > _FAR * np.maximum(
-                    np.abs(scale), np.maximum(np.abs(z), 1.0))):
+            if np.all(z + dz == z) or np.any(np.abs(dz) > _reach(z, scale)):
                 return None  # (no move, or one beyond any state of the branch)
             ev1, r1 = residual(z + dz)
             if not np.linalg.norm(r1 / rscale) < np.linalg.norm(r / rscale):
@@ -252,9 +260,8 @@ def _newton(residual, z0, scale, rscale, jacobians=None, tol=1e-12, max_iter=30)
         except np.linalg.LinAlgError:
             return None
         norm = np.linalg.norm(r / rscale)
-        # (no trial beyond any state of the branch: see _FAR)
-        reach = _FAR * np.maximum(np.abs(scale), np.maximum(np.abs(z), 1.0))
-        lam = min(1.0, float(np.min(reach / np.maximum(np.abs(dx), 1e-300))))
+        # (no trial beyond any state of the branch: see _reach)
+        lam = min(1.0, float(np.min(_reach(z, scale) / np.maximum(np.abs(dx), 1e-300))))
         while lam > 1.0 / 1024:
             try:
                 ev_t, r_t = residual(z + lam * dx)
