@@ -240,10 +240,27 @@ def test_ctrl_c_in_a_ladder_level_leaves_a_valid_file_marked_incomplete(tmp_path
 
     monkeypatch.setattr(onset_kernels, "march", interrupt_the_third_level)
     out = tmp_path / "cut.h5"
-    assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot"]) == 130
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot",
+                 "--set", "numerics.method=stepper"]) == 130
     assert "complete = False" in capsys.readouterr().err
     rec = h5io.load(out)
     assert rec["complete"] is False and np.all(np.isfinite(rec["history"]["gap"]))
+
+
+def test_ctrl_c_in_the_quadrature_onset_writes_no_file(tmp_path, capsys, monkeypatch):
+    """The quadrature onset takes a fraction of a millisecond and keeps no partial state: a
+    Ctrl-C in it ends the run with no result or temporary file left (the lock stays, as after
+    every run: see the README)."""
+    from pulloff.kernels import onset_quadrature as quadrature_kernels
+
+    def interrupt(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(quadrature_kernels, "detach_time", interrupt)
+    out = tmp_path / "cut.h5"
+    assert main(["run", str(SEED), "-o", str(out), "-q", "--no-plot"]) == 130
+    assert "no partial file written" in capsys.readouterr().err
+    assert [p.name for p in tmp_path.iterdir()] == [".cut.h5.lock"]
 
 
 def test_cli_run_without_a_plot(tmp_path):
@@ -253,7 +270,7 @@ def test_cli_run_without_a_plot(tmp_path):
     assert h5io.load(out)["summary"]["detached"]
 
 
-@pytest.mark.parametrize("config,kernel", [("seed_flat_punch", "onset.march"),
+@pytest.mark.parametrize("config,kernel", [("seed_flat_punch", "onset_quadrature.secant_root"),
                                            ("separation_kv", "contact.evaluate_step"),
                                            ("frozen_history", None)])
 def test_the_compile_notice_follows_the_kernels_the_scene_needs(config, kernel, tmp_path,
@@ -295,5 +312,5 @@ def test_numba_is_asked_whether_a_solvers_kernel_is_cached():
     from pulloff.kernels import cache_is_warm, cached_entries
 
     simulate(load_scene(SEED))
-    assert cached_entries("onset.march") >= 1
-    assert cache_is_warm("onset.march")
+    assert cached_entries("onset_quadrature.secant_root") >= 1
+    assert cache_is_warm("onset_quadrature.secant_root")

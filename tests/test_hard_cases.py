@@ -4,6 +4,7 @@ Each runs at a modest rtol and is checked against the independent quadrature ref
 NaN, a bounded number of steps, the true error within rtol and the estimate not hiding it.
 """
 
+import functools
 import math
 from pathlib import Path
 
@@ -23,23 +24,33 @@ RTOL = 1e-5
 FLOOR = 1e-10
 
 
-def run(name, rtol=RTOL):
-    return simulate(load_scene(HARD / f"{name}.yaml", overrides=[f"numerics.rtol={rtol}"]))
+#: The onset's two methods: every hard case is run by both.
+METHODS = ("quadrature", "stepper")
+
+
+def run(name, rtol=RTOL, method=None):
+    overrides = [f"numerics.rtol={rtol}"] + ([f"numerics.method={method}"] if method else [])
+    return simulate(load_scene(HARD / f"{name}.yaml", overrides=overrides))
+
+
+@functools.lru_cache(maxsize=None)
+def _reference(p, rtol):
+    return reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=rtol)
 
 
 def largest_error(res, reference_rtol=1e-12):
     """The largest relative error of the onset time and forces against the reference."""
-    p = res.problem
-    ref = reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0,
-                               rtol=reference_rtol)
+    ref = _reference(res.problem, reference_rtol)
     return max(abs(res.t_detach / ref["t_detach"] - 1),
                abs(res.F_contact_detach / ref["F_contact"] - 1),
                abs(res.F_total_detach / ref["F_total"] - 1))
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("name", DETACHING)
-def test_hard_case_meets_rtol_against_the_reference(name):
-    res = run(name)
+def test_hard_case_meets_rtol_against_the_reference(name, method):
+    res = run(name, method=method)
+    assert res.summary["solver"] == {"quadrature": "onset_quadrature", "stepper": "onset"}[method]
     assert res.detached
     for values in res.history.values():
         assert np.all(np.isfinite(values))
@@ -72,28 +83,31 @@ def test_no_detachment_before_t_max():
     assert res.t_end == pytest.approx(5e-3, rel=1e-12)
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("rtol", [1e-3, 1e-6, 1e-8])
 @pytest.mark.parametrize("name", DETACHING)
-def test_each_rtol_on_hard_cases(name, rtol):
+def test_each_rtol_on_hard_cases(name, rtol, method):
     """Every output the onset reports (its time and both forces), not the contact force
     alone: on a thin zone the force follows the lift and the time's error is up to 3000x the
     force's (metre_punch at rtol 1e-6: 9.6e-9 against 3.1e-12)."""
-    res = run(name, rtol)
+    res = run(name, rtol, method)
     error = largest_error(res)
     assert error <= rtol
     assert res.error_estimate >= error / 10.0 or error < FLOOR
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("rtol", [1e-6, 1e-8])
 @pytest.mark.parametrize("G", [1e-2, 1e-1, 1.0, 10.0])
-def test_nearly_viscous_solids_whose_zone_barely_grows(G, rtol):
+def test_nearly_viscous_solids_whose_zone_barely_grows(G, rtol, method):
     """near_viscous with G raised to 1e-2 .. 10 Pa (relaxation times 1e7 .. 1e4 s against a
     1.6 ms pull): the zone grows by k t = 3e-11 .. 3e-8 inside the last interval of the
     preloaded mesh, and the ladder's extrapolations creep (README, Known issues). Measured:
     every rtol from 1e-6 to 1e-9 met, the estimate down to 1/8.7 of the error at rtol 1e-8
     (G = 0.1) and to 1/15 at rtol 1e-9 (G = 1e-2, not asserted here: the known issue)."""
     res = simulate(load_scene(HARD / "near_viscous.yaml",
-                              overrides=[f"material.G={G}", f"numerics.rtol={rtol}"]))
+                              overrides=[f"material.G={G}", f"numerics.rtol={rtol}",
+                                         f"numerics.method={method}"]))
     error = largest_error(res)
     assert error <= rtol
     assert res.error_estimate >= error / 10.0 or error < FLOOR

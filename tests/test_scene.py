@@ -140,7 +140,7 @@ REJECT = [
     ("adhesion.sigma_c=-5e6", "adhesion.sigma_c", "-5e6", "> 0"),
     ("adhesion.delta=.inf", "adhesion.delta", "inf", "finite"),
     ("numerics.rtol=0.5", "numerics.rtol", "0.5", "<= 0.1"),
-    ("numerics.rtol=1e-11", "numerics.rtol", "1e-11", ">= 1e-10"),
+    ("numerics.rtol=1e-13", "numerics.rtol", "1e-13", ">= 1e-12"),
     ("numerics.t_max=0", "numerics.t_max", "0", "> 0"),
     ("output.history_rows=1", "output.history_rows", "1", ">= 2"),
     ("output.history_rows=2.5", "output.history_rows", "2.5", "integer"),

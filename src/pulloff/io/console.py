@@ -123,8 +123,10 @@ def format_table(record: dict, title: str | None = None) -> str:
     for note in filter(None, str(s.get("notes", "")).split("; ")):
         lines.append(f"  note: {note}")
     rows = record.get("history_rows_in_file", len(record["history"]["t"]))
-    lines.append(f"  elements {s['n_elements']}, steps {s['n_steps']}, history rows {rows}, "
-                 f"wall time {s['wall_time'] * 1e3:.1f} ms")
+    work = (f"Gauss nodes {s['n_elements']}, gap evaluations {s['n_steps']}"
+            if s.get("solver") == "onset_quadrature"
+            else f"elements {s['n_elements']}, steps {s['n_steps']}")
+    lines.append(f"  {work}, history rows {rows}, wall time {s['wall_time'] * 1e3:.1f} ms")
     return "\n".join(lines)
 
 

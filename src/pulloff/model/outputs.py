@@ -94,9 +94,11 @@ OUTPUTS = (
     _s("V", "1", "viscous against cohesive stress eta v / (sigma_c a)", "pull"),
     _s("error_estimate", "1", "estimated relative error of the controlled outputs"),
     _s("observed_order", "1", "order of the error in the step, measured from the last three "
-                              "levels (nan where they do not support one)"),
-    _s("n_elements", "1", "foundation elements of the reported run"),
-    _s("n_steps", "1", "time steps of the reported run"),
+                              "levels (nan where they do not support one, and for the "
+                              "quadrature onset, which has no steps)"),
+    _s("n_elements", "1", "foundation elements of the reported run (quadrature onset: Gauss "
+                          "nodes of one gap evaluation at the onset)"),
+    _s("n_steps", "1", "time steps of the reported run (quadrature onset: gap evaluations)"),
     _s("wall_time", "s", "wall-clock time of the simulation"),
     _s("t_end", "s", "last simulated time"),
     _s("solver", "", "the solver that ran the scene", text=True),

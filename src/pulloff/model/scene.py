@@ -63,11 +63,18 @@ class ModelSection(_Section):
 class Numerics(_Section):
     """Accuracy and time span of the solver."""
 
-    # Below 1e-10 a run costs minutes (the work grows like 1/rtol) and rounding in the gap
-    # integral approaches the target; 1e-10 takes seconds.
-    rtol: Num = Field(1e-6, ge=1e-10, le=1e-1,
+    # The quadrature onset reaches 1e-12 in well under a millisecond; the steppers refuse
+    # below STEPPER_RTOL_FLOOR (a run costs minutes there, solvers.base).
+    rtol: Num = Field(1e-6, ge=1e-12, le=1e-1,
                       description="target relative accuracy of F and t (with steps: the "
-                                  "accuracy the fixed run is checked against), dimensionless")
+                                  "accuracy the fixed run is checked against; below 1e-10 "
+                                  "the quadrature onset only), dimensionless")
+    method: Optional[Literal["quadrature", "stepper"]] = Field(
+        None, description="how the seed's onset is solved: quadrature (the gap as one integral "
+                          "over the load history) or stepper (the time-stepped foundation); "
+                          "null: quadrature unless the scene needs steps (numerics.steps, "
+                          "output.every, output.snapshots); past the onset always the "
+                          "stepper, no unit")
     t_max: Optional[Num] = Field(None, gt=0, description="end time, s; null: the solver chooses")
     steps: Optional[Int] = Field(
         None, ge=16, le=1_000_000_000,

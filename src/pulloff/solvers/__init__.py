@@ -15,9 +15,12 @@ from .contact import ContactSolver
 from .frozen import FrozenSolver
 from .observers import Observers
 from .onset import OnsetSolver
+from .onset_quadrature import OnsetQuadratureSolver
 
-#: In order of preference: the specialised closed form and onset stepper before the general one.
-SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetSolver(), ContactSolver())
+#: In order of preference: the specialised closed form, the onset by quadrature and the onset
+#: stepper before the general one.
+SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetQuadratureSolver(), OnsetSolver(),
+                               ContactSolver())
 
 
 def route(scene) -> Solver:

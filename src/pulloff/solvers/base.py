@@ -25,6 +25,28 @@ class Solver:
         raise NotImplementedError
 
 
+#: The time steppers' smallest rtol: below it a run costs minutes (their work grows like a
+#: power of 1/rtol), while the quadrature onset reaches the schema's 1e-12 at once.
+STEPPER_RTOL_FLOOR = 1e-10
+
+
+def stepper_settings(scene, solver: str) -> list[str]:
+    """Problems of a scene for a time-stepping solver: ``numerics.method = quadrature`` and
+    an rtol below :data:`STEPPER_RTOL_FLOOR`."""
+    out = []
+    if scene.numerics.method == "quadrature":
+        out.append(problem(
+            "numerics.method", "quadrature", f"the {solver} solver steps; the quadrature "
+            "covers a Kelvin-Voigt flat punch to its onset (no steps, snapshots or "
+            "output.every)"))
+    if scene.numerics.rtol < STEPPER_RTOL_FLOOR:
+        out.append(problem(
+            "numerics.rtol", scene.numerics.rtol, f"below {STEPPER_RTOL_FLOOR:g} the {solver} "
+            "solver costs minutes; the quadrature onset (a Kelvin-Voigt flat punch to its "
+            "onset, no steps) goes to 1e-12"))
+    return out
+
+
 def problem(key: str, value, reason: str) -> str:
     """One problem line: the dotted key, the value as a user writes it, the reason."""
     return f"{key} = {fmt(value)}: {reason}"

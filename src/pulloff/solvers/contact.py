@@ -15,7 +15,7 @@ import numpy as np
 
 from ..model import analytic
 from . import levels as ladder
-from .base import Solver, problem as problem_line
+from .base import Solver, problem as problem_line, stepper_settings
 from .contact_setup import FLAT_EXTERNAL, setup as make_setup
 from .contact_stepper import MAX_STEPS, Stepper
 from .frozen import frozen_detach_time
@@ -123,7 +123,7 @@ class ContactSolver(Solver):
             out.append(problem_line(
                 "output.snapshots", list(scene.output.snapshots), "the contact solver stores "
                 "no displacement profiles yet"))
-        return out
+        return out + stepper_settings(scene, "contact")
 
     def solve(self, scene, observers) -> Result:
         wall = time.perf_counter()

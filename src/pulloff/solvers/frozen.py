@@ -118,6 +118,10 @@ class FrozenSolver(Solver):
             if value is not None:
                 out.append(problem_line(f"numerics.{key}", value, "nothing is stepped with "
                                         "model.history = frozen (a closed form); remove it"))
+        if scene.numerics.method is not None:
+            out.append(problem_line("numerics.method", scene.numerics.method, "the frozen "
+                                    "history is a closed form, neither stepped nor integrated; "
+                                    "remove it"))
         if scene.output.every is not None:
             out.append(problem_line("output.every", scene.output.every, "nothing is stepped "
                                     "with model.history = frozen; its history has "

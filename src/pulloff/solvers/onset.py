@@ -26,7 +26,7 @@ import numpy as np
 from ..kernels import onset as kernels
 from ..model import analytic
 from . import levels as ladder
-from .base import Solver, flat_punch_pull, problem as problem_line
+from .base import Solver, flat_punch_pull, problem as problem_line, stepper_settings
 from .frozen import frozen_detach_time, frozen_gap, zone_ratio
 from .observers import decimate, no_progress, stream_every
 from .problem import Problem, si_history
@@ -384,6 +384,22 @@ def _field(sig_pre, U_pre, sig_born, U_born, n_born):
 # --------------------------------------------------------------------------------------------
 # Accuracy control and the SI result.
 
+def seed_onset_problems(scene, solver: str) -> list[str]:
+    """Problems of a scene for a solver of the seed's onset (Kelvin-Voigt or elastic, exact
+    history, to the onset)."""
+    out = flat_punch_pull(scene, solver)
+    if scene.material.kind not in ("kelvin_voigt", "elastic"):
+        out.append(problem_line("material.kind", scene.material.kind,
+                                f"the {solver} solver takes Kelvin-Voigt and elastic solids"))
+    if scene.model.history != "exact":
+        out.append(problem_line("model.history", scene.model.history,
+                                f"the {solver} solver solves the exact load history"))
+    if scene.model.until != "detach":
+        out.append(problem_line("model.until", scene.model.until,
+                                f"the {solver} solver stops at the onset of detachment"))
+    return out
+
+
 class OnsetSolver(Solver):
     """The seed scene to its onset: a flat punch with its zone outside, a Kelvin-Voigt (or
     elastic) solid, a rigid machine pulling at constant speed; exact load history."""
@@ -393,17 +409,7 @@ class OnsetSolver(Solver):
     summary = "seed onset stepper (flat punch, external zone, Kelvin-Voigt, rigid pull)"
 
     def unsupported(self, scene) -> list[str]:
-        out = flat_punch_pull(scene, "onset")
-        if scene.material.kind not in ("kelvin_voigt", "elastic"):
-            out.append(problem_line("material.kind", scene.material.kind,
-                                    "the onset solver steps Kelvin-Voigt and elastic solids"))
-        if scene.model.history != "exact":
-            out.append(problem_line("model.history", scene.model.history,
-                                    "the onset solver steps the exact load history"))
-        if scene.model.until != "detach":
-            out.append(problem_line("model.until", scene.model.until,
-                                    "the onset solver stops at the onset of detachment"))
-        return out
+        return seed_onset_problems(scene, "onset") + stepper_settings(scene, "onset")
 
     def solve(self, scene, observers) -> Result:
         wall_start = time.perf_counter()
@@ -431,7 +437,7 @@ class OnsetSolver(Solver):
         streamed = observers.stream is not None and scene.numerics.steps is not None
         if streamed:
             _end_stream(problem, run, observers, scene.numerics.steps)
-        return _assemble(scene, problem, run, estimate, order, observers,
+        return assemble(scene, problem, run, estimate, order, observers,
                          time.perf_counter() - wall_start, notes, streamed)
 
 
@@ -448,7 +454,7 @@ def _n_steps_for(rtol: float) -> int:
     return int(min(_MAX_STEPS, max(_MIN_STEPS, math.ceil((_STEP_CONSTANT / rtol) ** (1 / 3)))))
 
 
-def _detach_outputs(problem: Problem, t: float, *more):
+def detach_outputs(problem: Problem, t: float, *more):
     return np.array([t, problem.contact_force(t), problem.total_force(t), *more], dtype=float)
 
 
@@ -457,7 +463,7 @@ def _outputs(problem: Problem, run: FoundationRun) -> np.ndarray:
     that does not detach (all levels end at the same time then)."""
     if math.isnan(run.t_detach):
         return np.array([math.nan, math.nan, math.nan, run.gap[-1]])
-    return _detach_outputs(problem, run.t_detach, math.nan)
+    return detach_outputs(problem, run.t_detach, math.nan)
 
 
 #: Steps of the fixed-step mode's default element arrays (``numerics.max_elements``).
@@ -509,7 +515,7 @@ def _fixed_run(problem, t_frozen, t_limit, numerics, observers):
         return full, _gap_difference(half, full)
     if full.t_detach == 0.0:
         return full, 0.0
-    values = [_detach_outputs(problem, r.t_detach) for r in runs]
+    values = [detach_outputs(problem, r.t_detach) for r in runs]
     return full, float(np.max(np.abs(values[0] - values[1]) / np.abs(values[0])) / 3.0)
 
 
@@ -581,8 +587,9 @@ def _gap_difference(coarse: FoundationRun, fine: FoundationRun) -> float:
     return float(np.max(np.abs(g_f - g_c)) / max(np.max(np.abs(g_f)), 1e-300)) / 3.0
 
 
-def _assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order: float,
-              observers, wall: float, notes: list, streamed: bool) -> Result:
+def assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order: float,
+             observers, wall: float, notes: list, streamed: bool, solver: str = "onset") -> Result:
+    """The SI result of an onset run (``solver``: its name in the summary)."""
     T = problem.time_scale
     detached = not math.isnan(run.t_detach)
     t_hist, gap_hist = run.t, run.gap
@@ -599,7 +606,7 @@ def _assemble(scene, problem: Problem, run: FoundationRun, estimate: float, orde
     summary = {"detached": detached, "error_estimate": float(estimate),
                "observed_order": float(order), "n_elements": int(run.n_elements),
                "n_steps": int(run.n_steps), "wall_time": wall, "t_end": float(t_hist[-1] * T),
-               "solver": "onset", "history": scene.model.history, "until": scene.model.until,
+               "solver": solver, "history": scene.model.history, "until": scene.model.until,
                "cohesive_zone": scene.geometry.cohesive_zone, **problem.groups}
     if detached:
         summary.update(

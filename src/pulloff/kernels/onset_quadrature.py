@@ -1,0 +1,235 @@
+"""Numba kernels of the onset by quadrature: the exact gap of the seed scene as one integral
+over the load history, with the zone's part in closed form.
+
+Dimensionless as :mod:`pulloff.kernels.onset` (lengths in ``a``, displacements in ``delta``,
+time in ``delta / v``; ``S(T) = k (H0 + T) + c``). An element at ``sigma`` entered the zone
+when ``S`` passed it (or at ``T = 0``) and carries
+``U = (1/c) int exp(-k (T - T')/c) sqrt(S(T')^2 - sigma^2) dT'``. Swapping the order of the
+gap's two integrals (over elements, then over their load history) gives
+
+    gap = (2/pi) [ H atan(S) - I ],
+    I(T) = (1/c) int_0^T exp(-k tau / c) K(S(T - tau)^2, S(T)^2) dtau,
+    K(P, Q) = 1/2 int_0^P sqrt(P - w) / sqrt((1 + w)(Q - w)) dw   (w = sigma^2),
+
+and ``K`` is an elliptic integral: Carlson's ``R_D`` in closed form (:func:`zone_kernel`). What
+is left is a one-dimensional integral in ``tau``, smooth but for a ``tau log tau`` term at
+``tau = 0`` (``K`` has ``d log d`` at ``d = Q - P -> 0``), which Gauss rules on panels graded
+geometrically toward ``tau = 0`` integrate to full precision with a few dozen nodes. The
+stepper (:mod:`pulloff.kernels.onset`) marches every element of the zone instead; both
+methods solve the same model, and the reference (:mod:`pulloff.references.onset`) integrates
+over the elements first, adaptively.
+
+Kernels that call each other live in this one module (numba's disk cache does not track
+cross-module changes).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+#: The memory kernel is cut where ``exp(-k tau / c)`` falls below ``exp(-_DECAYS)``: e^-40
+#: ~ 4e-18 of an integrand that is largest at ``tau = 0``.
+_DECAYS = 40.0
+#: Edges, in relaxation times ``c / k``, of the panels past the first relaxation time: each
+#: short enough for a Gauss rule of the level's order on ``exp(-y)`` (the error of ``n``
+#: points on a panel of length ``L`` is ~``(L/2)^(2n) / (2n)!`` of its weight).
+DECAY_EDGES = np.array([1.0, 2.0, 4.0, 8.0, 13.0, 19.0, 26.0, 33.0, _DECAYS])
+#: Ratio of consecutive panels graded toward ``tau = 0``.
+_GRADING = 0.25
+
+
+@njit(cache=True)
+def carlson_rd(x, y, z):
+    """Carlson's ``R_D(x, y, z) = 3/2 int_0^inf dt / (sqrt((t+x)(t+y)) (t+z)^(3/2))`` for
+    ``x, y >= 0`` (at most one zero) and ``z > 0``, to ~1e-16 relative: duplication until the
+    arguments agree to the series' order, then its seventh-order expansion (B. C. Carlson,
+    Numer. Algorithms 10 (1995) 13-26; DLMF 19.36.2)."""
+    a0 = (x + y + 3.0 * z) / 5.0
+    a = a0
+    # (r/4)^(-1/6) = 575 for r = 2^-53: the series' error then stays below the rounding.
+    q = 6.0e2 * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
+    total = 0.0
+    scale = 1.0
+    while scale * q >= abs(a):
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+        lam = sx * sy + sx * sz + sy * sz
+        total += scale / (sz * (z + lam))
+        scale *= 0.25
+        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
+    X = (a - x) / a
+    Y = (a - y) / a
+    Z = -(X + Y) / 3.0
+    xy, zz = X * Y, Z * Z
+    e2 = xy - 6.0 * zz
+    e3 = (3.0 * xy - 8.0 * zz) * Z
+    e4 = 3.0 * (xy - zz) * zz
+    e5 = xy * zz * Z
+    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
+    return scale * series / (a * math.sqrt(a)) + 3.0 * total
+
+
+@njit(cache=True)
+def zone_kernel(P, d):
+    """``K(P, P + d) = 1/2 int_0^P sqrt(P - w) / sqrt((1 + w)(P + d - w)) dw`` for
+    ``P, d >= 0``: the zone's weight of a load ``S'^2 = P`` seen by the gap at ``S^2 = P + d``.
+
+    With ``w = P - P / (t + 1)`` the integral is ``P^(3/2) R_D(1/(1+P), (P+d)/d, 1) /
+    (3 sqrt((1+P) d))``; at ``d = 0`` it is ``sqrt(1 + P) - 1``, the frozen zone's width."""
+    if d <= 0.0:
+        return P / (1.0 + math.sqrt(1.0 + P))
+    if P <= 0.0:
+        return 0.0
+    return P * math.sqrt(P) * carlson_rd(1.0 / (1.0 + P), (P + d) / d, 1.0) / (
+        3.0 * math.sqrt((1.0 + P) * d))
+
+
+@njit(cache=True)
+def _panel(lo, hi, k, c, S, nodes, weights):
+    """``(1/c) int_lo^hi exp(-k tau/c) K(S(T - tau)^2, S^2) dtau`` by the Gauss rule
+    ``nodes, weights`` on [0, 1]."""
+    width = hi - lo
+    total = 0.0
+    for i in range(nodes.size):
+        tau = lo + width * nodes[i]
+        k_tau = k * tau
+        s_then = S - k_tau
+        total += weights[i] * math.exp(-k_tau / c) * zone_kernel(s_then * s_then,
+                                                                  k_tau * (S + s_then))
+    return total * width / c
+
+
+@njit(cache=True)
+def memory_integral(k, c, H0, T, n_graded, nodes, weights):
+    """``I(T)`` of the module docstring: ``n_graded`` panels graded toward ``tau = 0`` over the
+    first relaxation time ``c / k`` (or all of ``[0, T]`` if shorter), then panels ending at
+    ``DECAY_EDGES`` relaxation times, cut at ``T``; each with the rule ``nodes, weights``."""
+    S = k * (H0 + T) + c
+    if T <= 0.0:
+        return 0.0
+    if c == 0.0:  # elastic: every element carries its current load
+        return zone_kernel(S * S, 0.0) / k
+    if k == 0.0:  # viscous: S is constant, the load too
+        return T / c * zone_kernel(S * S, 0.0)
+    relax = c / k
+    hi = min(T, relax)
+    total = 0.0
+    for j in range(n_graded):
+        lo = hi * _GRADING if j < n_graded - 1 else 0.0
+        total += _panel(lo, hi, k, c, S, nodes, weights)
+        hi = lo
+    for j in range(DECAY_EDGES.size - 1):
+        lo = DECAY_EDGES[j] * relax
+        if lo >= T:
+            break
+        total += _panel(lo, min(T, DECAY_EDGES[j + 1] * relax), k, c, S, nodes, weights)
+    return total
+
+
+@njit(cache=True)
+def nodes_per_gap(k, c, T, n_graded, n_points):
+    """Gauss nodes of one :func:`memory_integral` at ``T``."""
+    if c == 0.0 or k == 0.0 or T <= 0.0:
+        return 0
+    panels = n_graded
+    for j in range(DECAY_EDGES.size - 1):
+        if DECAY_EDGES[j] * c / k >= T:
+            break
+        panels += 1
+    return panels * n_points
+
+
+@njit(cache=True)
+def gap(k, c, H0, T, n_graded, nodes, weights):
+    """The gap at the end of the zone at ``T``, in ``delta``."""
+    S = k * (H0 + T) + c
+    return (2.0 / math.pi) * ((H0 + T) * math.atan(S)
+                              - memory_integral(k, c, H0, T, n_graded, nodes, weights))
+
+
+@njit(cache=True)
+def gaps(k, c, H0, times, n_graded, nodes, weights):
+    """:func:`gap` at each of ``times``."""
+    out = np.empty(times.size)
+    for i in range(times.size):
+        out[i] = gap(k, c, H0, times[i], n_graded, nodes, weights)
+    return out
+
+
+@njit(cache=True)
+def detach_time(k, c, H0, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
+    """The root of ``gap = 1`` in ``[lo, hi]``, where ``g_lo = gap(lo) - 1 < 0 <= g_hi =
+    gap(hi) - 1``, by the Illinois variant of regula falsi, to rounding: ``(T, slope,
+    evaluations)`` with ``slope`` the last secant's ``d gap / dT``."""
+    n_eval = 0
+    side = 0
+    last = hi
+    for _ in range(100):
+        if g_hi == 0.0 or hi - lo <= 4.0 * 2.2e-16 * hi:
+            break
+        mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        if not lo < mid < hi:
+            mid = 0.5 * (lo + hi)
+        if abs(mid - last) <= 2.2e-16 * mid:
+            break  # the iterates stand still: rounding decides the last digit
+        last = mid
+        g_mid = gap(k, c, H0, mid, n_graded, nodes, weights) - 1.0
+        n_eval += 1
+        if g_mid < 0.0:
+            lo, g_lo = mid, g_mid
+            if side == -1:
+                g_hi *= 0.5
+            side = -1
+        else:
+            hi, g_hi = mid, g_mid
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+    slope = (g_hi - g_lo) / (hi - lo) if hi > lo else 0.0
+    root = hi if g_hi == 0.0 or -g_lo > g_hi else lo
+    return root, slope, n_eval
+
+
+@njit(cache=True)
+def secant_root(k, c, H0, t0, slope, n_graded, nodes, weights):
+    """The root of ``gap = 1`` near ``t0`` by secants from ``t0`` with the first slope
+    ``slope`` (a root of a nearby rule): ``(T, evaluations)``; ``T`` is nan where the
+    iterates do not settle within 12 evaluations (the caller then brackets)."""
+    g0 = gap(k, c, H0, t0, n_graded, nodes, weights) - 1.0
+    n_eval = 1
+    for _ in range(11):
+        if g0 == 0.0 or not slope != 0.0:
+            return t0, n_eval
+        t1 = t0 - g0 / slope
+        if abs(t1 - t0) <= 2.2e-16 * abs(t1):
+            return t1, n_eval
+        g1 = gap(k, c, H0, t1, n_graded, nodes, weights) - 1.0
+        n_eval += 1
+        if g1 != g0:
+            slope = (g1 - g0) / (t1 - t0)
+        t0, g0 = t1, g1
+    return math.nan, n_eval
+
+
+@njit(cache=True)
+def lobatto_interpolate(u_nodes, values, u, out):
+    """The polynomial through ``values`` at the Chebyshev-Lobatto nodes ``u_nodes`` of
+    ``[0, 1]`` (``(1 - cos(pi j / n)) / 2``, ascending), at each ``u``, written to ``out``
+    (the barycentric formula: stable at every degree)."""
+    n = u_nodes.size - 1
+    for i in range(u.size):
+        num = 0.0
+        den = 0.0
+        exact = -1
+        for j in range(n + 1):
+            diff = u[i] - u_nodes[j]
+            if diff == 0.0:
+                exact = j
+                break
+            w = (0.5 if j == 0 or j == n else 1.0) * (1.0 if j % 2 == 0 else -1.0) / diff
+            num += w * values[j]
+            den += w
+        out[i] = values[exact] if exact >= 0 else num / den

@@ -1,0 +1,242 @@
+"""The seed's onset by quadrature: the gap as one integral over the load history
+(:mod:`pulloff.kernels.onset_quadrature`), its root, and the history as an interpolant.
+
+Each Gauss rule of :data:`_RULES` integrates the gap to a known accuracy (measured on the
+work-precision scenes and the hard cases against the reference: the errors of
+:data:`_RULE_ERRORS`). A run takes the cheapest rule expected to be well within ``rtol``,
+solves ``gap = 1`` with it and with the next rule, and reports the finer root; the estimate is
+the two roots' difference (that of the coarser rule, so a cautious one). The history is the
+polynomial interpolant of the gap in ``u = sqrt(t / t_end)`` (the gap has a ``t^2 log t`` term
+at ``t = 0``, smooth in ``u``) on Chebyshev-Lobatto nodes, doubled until the interpolant of
+half the nodes is within ``rtol`` of the other half: its nodes bracket the first crossing.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+
+import numpy as np
+
+from ..kernels import onset_quadrature as kernels
+from .base import Solver, problem as problem_line
+from .frozen import frozen_detach_time
+from .onset import FoundationRun, assemble, detach_outputs, seed_onset_problems
+from .problem import Problem
+
+#: Gauss-Legendre points per panel and panels graded toward the newest load, coarsest first.
+_RULES = ((4, 3), (6, 4), (8, 6), (10, 8), (12, 10), (16, 14))
+#: The largest relative error of each rule's detachment time over the four work-precision
+#: scenes and the hard cases (against the reference at rtol 1e-12, whose own floor is ~1e-12;
+#: ``/tmp`` study, the table in the README).
+_RULE_ERRORS = (2e-6, 2e-8, 5e-11, 2e-13, 2e-15, 1e-16)
+#: The first rule is expected this far within rtol: the next one then checks it cheaply.
+_RULE_MARGIN = 10.0
+#: Chebyshev-Lobatto intervals of the history's first and largest interpolant.
+_FIRST_NODES = 16
+_MAX_NODES = 1024
+#: Rows of the history at most (``output.history_rows`` may ask for fewer): uniform in time, of
+#: an interpolant of 17-65 nodes, so more rows draw the same curve and cost ~0.1 ms per 1000
+#: (the SI columns and the closed forms of each row); a run at rtol 1e-6 costs ~0.3 ms.
+HISTORY_ROWS = 257
+
+
+@functools.lru_cache(maxsize=None)
+def _rule(m: int):
+    """``(graded panels, nodes, weights)`` of rule ``m`` on [0, 1]."""
+    n, graded = _RULES[m]
+    x, w = np.polynomial.legendre.leggauss(n)
+    return graded, 0.5 * (x + 1.0), 0.5 * w
+
+
+@functools.lru_cache(maxsize=None)
+def _lobatto(n: int) -> np.ndarray:
+    """The ``n + 1`` Chebyshev-Lobatto nodes of [0, 1], ascending, 0 and 1 exact."""
+    u = 0.5 * (1.0 - np.cos(np.pi * np.arange(n + 1) / n))
+    u[0], u[-1] = 0.0, 1.0
+    return u
+
+
+def first_rule(rtol: float) -> int:
+    """The cheapest rule expected to be :data:`_RULE_MARGIN` within ``rtol`` (the last but
+    one at most: the last checks it)."""
+    for m, error in enumerate(_RULE_ERRORS[:-1]):
+        if error * _RULE_MARGIN <= rtol:
+            return m
+    return len(_RULES) - 2
+
+
+class QuadratureRun:
+    """The gap of one problem under one rule: evaluations counted."""
+
+    def __init__(self, problem: Problem, m: int):
+        self.k, self.c, self.H0 = problem.k, problem.c, problem.h0_scaled
+        self.m = m
+        self.rule = _rule(m)
+        self.evaluations = 0
+
+    def nodes_per_gap(self, t: float) -> int:
+        graded, nodes, _ = self.rule
+        return kernels.nodes_per_gap(self.k, self.c, t, graded, nodes.size)
+
+    def gaps(self, t: np.ndarray) -> np.ndarray:
+        self.evaluations += t.size
+        return kernels.gaps(self.k, self.c, self.H0, np.ascontiguousarray(t, dtype=float),
+                            *self.rule)
+
+    def root_in(self, lo, hi, g_lo, g_hi):
+        """``(root, slope)`` in a bracket whose gaps minus 1 are ``g_lo < 0 <= g_hi``."""
+        root, slope, n = kernels.detach_time(self.k, self.c, self.H0, lo, hi, g_lo, g_hi,
+                                             *self.rule)
+        self.evaluations += n
+        return root, slope
+
+    def root_near(self, t0, slope, lo, hi, bounded=False):
+        """The root near ``t0`` (secants), or in ``[lo, hi]`` if they do not settle there;
+        nan if ``[lo, hi]`` brackets none. ``bounded``: the gap is at least 1 at ``hi``
+        (whatever its rounding says, see :func:`_crossing`)."""
+        root, n = kernels.secant_root(self.k, self.c, self.H0, t0, slope, *self.rule)
+        self.evaluations += n
+        if bounded and root > hi:
+            return hi
+        if not lo <= root <= hi:
+            g = self.gaps(np.array([lo, hi])) - 1.0
+            if bounded:
+                g[1] = max(g[1], 0.0)
+            if not (g[0] < 0.0 <= g[1]):
+                return math.nan
+            root, _ = self.root_in(lo, hi, g[0], g[1])
+        return root
+
+
+def history_interpolant(run: QuadratureRun, t_end: float, rtol: float):
+    """``(u nodes, gaps, estimate)``: the gap at Chebyshev-Lobatto nodes in ``u = sqrt(t /
+    t_end)``, doubled until the interpolant through every other node is within ``rtol`` (in
+    ``delta``) at the rest, or :data:`_MAX_NODES`; ``estimate`` is that largest difference."""
+    n = _FIRST_NODES
+    u = _lobatto(n)
+    values = run.gaps(t_end * u * u)
+    while True:
+        odd = u[1::2]
+        coarse = np.empty(odd.size)
+        kernels.lobatto_interpolate(u[::2], values[::2], odd, coarse)
+        estimate = float(np.max(np.abs(coarse - values[1::2])))
+        if estimate <= rtol or n >= _MAX_NODES:
+            return u, values, estimate
+        n *= 2
+        u_new = _lobatto(n)
+        fresh = u_new[1::2]
+        merged = np.empty(n + 1)
+        merged[::2] = values
+        merged[1::2] = run.gaps(t_end * fresh * fresh)
+        u, values = u_new, merged
+
+
+def _relative_change(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest ``|a - b| / |b|`` over the outputs (nan-free; ``|b| = 0`` judged absolutely)."""
+    scale = np.where(b != 0.0, np.abs(b), 1.0)
+    return float(np.max(np.abs(a - b) / scale))
+
+
+def _crossing(problem: Problem, m: int, t_end: float, bounded: bool, rtol: float):
+    """One try at rule ``m``: ``(t_detach or nan, estimate, history, runs)`` where
+    ``history = (u nodes, gaps, interpolation estimate)`` and ``runs`` the two rules'
+    :class:`QuadratureRun` (for their counts). ``bounded``: ``t_end`` is the frozen onset,
+    where the exact gap is at least 1."""
+    coarse, fine = QuadratureRun(problem, m), QuadratureRun(problem, m + 1)
+    u, values, spread = history_interpolant(coarse, t_end, rtol)
+    if bounded and values[-1] < 1.0:
+        # The bound holds exactly, its rounding does not: an elastic solid (whose gap is the
+        # frozen one) reaches 1 within an ulp of t_end, on either side.
+        values[-1] = 1.0
+    above = np.nonzero(values >= 1.0)[0]
+    if above.size == 0:
+        # No crossing before t_end: what is controlled is the gap there.
+        end = fine.gaps(np.array([t_end]))
+        return math.nan, _relative_change(values[-1:], end), (u, values, spread), (coarse, fine)
+    j = int(above[0])  # > 0: a gap of 1 at t = 0 never comes here (t_end = 0)
+    lo, hi = t_end * u[j - 1] ** 2, t_end * u[j] ** 2
+    t_coarse, slope = coarse.root_in(lo, hi, values[j - 1] - 1.0, values[j] - 1.0)
+    # Where the finer rule's root left the bracket the two rules differ by a node spacing:
+    # the widest bracket the history allows.
+    last = j == u.size - 1
+    t_fine = fine.root_near(t_coarse, slope, lo, hi, bounded and last)
+    if math.isnan(t_fine):
+        t_fine = fine.root_near(t_coarse, slope, t_end * u[max(j - 2, 0)] ** 2,
+                                t_end * u[min(j + 1, u.size - 1)] ** 2,
+                                bounded and j + 1 >= u.size - 1)
+    if math.isnan(t_fine):
+        return t_coarse, math.inf, (u, values, spread), (coarse, fine)
+    estimate = _relative_change(detach_outputs(problem, t_coarse),
+                                detach_outputs(problem, t_fine))
+    return t_fine, estimate, (u, values, spread), (coarse, fine)
+
+
+def quadrature_onset(problem: Problem, t_end: float, bounded: bool, rtol: float, rows: int):
+    """The onset before ``t_end`` (dimensionless; ``bounded``: the frozen onset, see
+    :func:`_crossing`): ``(FoundationRun, estimate, notes)``.
+
+    Rules from :func:`first_rule` up, until two consecutive ones agree within ``rtol / 2``;
+    the finer one's root is reported, the history (``rows`` rows, uniform in time, to the
+    onset or ``t_end``) is the coarser one's interpolant."""
+    if t_end == 0.0:
+        gap0 = float(kernels.gap(problem.k, problem.c, problem.h0_scaled, 0.0, *_rule(0)))
+        return (FoundationRun(math.nan, np.zeros(1), np.array([gap0]), 0.0, 0, 0), 0.0, [])
+    m = first_rule(rtol)
+    while True:
+        t_detach, estimate, (u, values, spread), runs = _crossing(problem, m, t_end, bounded, rtol)
+        if estimate <= 0.5 * rtol or m + 2 >= len(_RULES):
+            break
+        m += 1
+    notes = []
+    if spread > rtol:
+        notes.append(f"history: the gap's interpolant is within {spread:.2g} of delta (not "
+                     f"{rtol:g}) at {u.size} nodes")
+    t_last = t_end if math.isnan(t_detach) else t_detach
+    t = np.linspace(0.0, t_last, max(2, rows))
+    gap = np.empty(t.size)
+    kernels.lobatto_interpolate(u, values, np.sqrt(t / t_end), gap)
+    run = FoundationRun(math.nan, t, gap, t_detach, runs[1].nodes_per_gap(t_last),
+                        sum(r.evaluations for r in runs))
+    return run, estimate, notes
+
+
+class OnsetQuadratureSolver(Solver):
+    """The seed scene to its onset by quadrature over the load history (Kelvin-Voigt or
+    elastic, flat punch, zone outside, rigid pull), without steps: the default where a scene
+    asks for no fixed steps, snapshots or ``output.every``."""
+
+    name = "onset_quadrature"
+    kernel = "onset_quadrature.secant_root"  # compiled last
+    summary = ("seed onset by quadrature over the load history (flat punch, external zone, "
+               "Kelvin-Voigt, rigid pull; no steps)")
+
+    def unsupported(self, scene) -> list[str]:
+        out = seed_onset_problems(scene, "quadrature onset")
+        why = "the quadrature onset has no steps or element fields; the stepper has"
+        if scene.numerics.method == "stepper":
+            out.append(problem_line("numerics.method", "stepper", "asks for the stepper"))
+        for key in ("steps", "max_elements"):
+            if getattr(scene.numerics, key) is not None:
+                out.append(problem_line(f"numerics.{key}", getattr(scene.numerics, key), why))
+        if scene.output.every is not None:
+            out.append(problem_line("output.every", scene.output.every, why))
+        if scene.output.snapshots:
+            out.append(problem_line("output.snapshots", scene.output.snapshots, why))
+        return out
+
+    def solve(self, scene, observers):
+        wall_start = time.perf_counter()
+        problem = Problem.from_scene(scene)
+        t_limit = (math.inf if scene.numerics.t_max is None
+                   else scene.numerics.t_max / problem.time_scale)
+        t_frozen = frozen_detach_time(problem, t_limit)
+        run, estimate, notes = quadrature_onset(problem, min(t_frozen, t_limit),
+                                                t_frozen <= t_limit, scene.numerics.rtol,
+                                                min(observers.history_rows, HISTORY_ROWS))
+        if not estimate <= scene.numerics.rtol:
+            notes.append(f"not converged: error estimate {estimate:.2g} above rtol "
+                         f"{scene.numerics.rtol:g} with the finest rule")
+        return assemble(scene, problem, run, estimate, math.nan, observers,
+                        time.perf_counter() - wall_start, notes, False, solver=self.name)
