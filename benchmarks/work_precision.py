@@ -7,7 +7,9 @@ For four scenes (alpha 0.1, 1 and 10 with a thin zone, chi = 1e-4, and alpha = 1
 independent quadrature reference (``pulloff.references.onset``, rtol 1e-12, good to ~1e-12) and the
 warm wall time [s] of:
 
-a. ``simulate`` at rtol 1e-2 .. 1e-9 (the product, accuracy control included);
+a. ``simulate`` at rtol 1e-2 .. 1e-12 (the product, accuracy control included: the onset by
+   quadrature), and ``simulate`` with ``numerics.method: stepper`` at rtol 1e-2 .. 1e-9 (the
+   time-stepped foundation, what a run with steps or snapshots uses);
 b. the bare stepper ``run_foundation`` at N = 25 .. 6400 steps per frozen detachment time
    (mesh matched to the step), and at N = 6400 with a ladder of preloaded meshes;
 c. the method of lines with ``solve_ivp`` (LSODA, Radau) on a fixed mesh (baselines.py);
@@ -51,7 +53,8 @@ SCENES = {  # name: (alpha, chi)
     "alpha=10 thin": (10.0, 1e-4),
     "alpha=10 wide": (10.0, 1.0),
 }
-RTOLS = [10.0**-e for e in range(2, 10)]
+RTOLS = [10.0**-e for e in range(2, 13)]
+STEPPER_RTOLS = [10.0**-e for e in range(2, 10)]
 STEP_LADDER = [25 * 2**j for j in range(9)]  # 25 .. 6400
 MESH_STEPS = 6400
 MESH_LADDER = [4 * 2**j for j in range(8)]  # 4 .. 512 preloaded elements
@@ -74,6 +77,7 @@ TARGET_ERROR, TARGET_TIME, TARGET_SPEEDUP = 1e-6, 1e-3, 1000.0
 TARGET_FINE_RTOL, TARGET_FINE_RATIO = 1e-8, 4.0
 
 M_SIM = "simulate (rtol)"
+M_SIM_STEP = "simulate, stepper (rtol)"
 M_STEP = "bare stepper, fixed N"
 M_MESH = f"stepper, N={MESH_STEPS}, n_preloaded"
 M_LSODA = "solve_ivp LSODA"
@@ -115,13 +119,17 @@ def measure_scene(name, alpha, chi):
     t_ref = frozen_detach_time(p)
     rows = []
 
-    # a. The product.
-    for rtol in RTOLS:
-        scene = scene_for_groups(alpha, chi, rtol=rtol)
-        timing, res = time_call(lambda: simulate(scene))
-        rows.append(make_row(name, M_SIM, f"rtol={rtol:.0e}", rtol, p, ref,
-                             res.t_detach / p.time_scale, timing, res.n_elements, res.n_steps,
-                             res.error_estimate))
+    # a. The product: its default (the quadrature) and its stepper.
+    for method, label, rtols in ((None, M_SIM, RTOLS), ("stepper", M_SIM_STEP, STEPPER_RTOLS)):
+        for rtol in rtols:
+            scene = scene_for_groups(alpha, chi, rtol=rtol)
+            if method:
+                scene = scene.model_copy(update={"numerics": scene.numerics.model_copy(
+                    update={"method": method})})
+            timing, res = time_call(lambda: simulate(scene))
+            rows.append(make_row(name, label, f"rtol={rtol:.0e}", rtol, p, ref,
+                                 res.t_detach / p.time_scale, timing, res.n_elements,
+                                 res.n_steps, res.error_estimate))
 
     # b. The bare stepper at fixed steps; d. the same algorithm in numpy, checked against it.
     stepper = {}
@@ -222,6 +230,21 @@ def time_to_reach(rows, target):
     return None, False
 
 
+def at_baseline_finest(ours, theirs):
+    """At the smallest error a baseline's ladder reaches: its time, simulate's cheapest run
+    at least as accurate, and their ratio (a lower bound at equal error: simulate's run is
+    more accurate still). None where simulate has no such run."""
+    finest = min((r for r in theirs if r["error_F"] > 0), key=lambda r: r["error_F"])
+    good = [r for r in ours if r["error_F"] <= finest["error_F"]]
+    if not good:
+        return None
+    cheapest = min(good, key=lambda r: r["time_median_s"])
+    return dict(error_baseline=finest["error_F"], t_baseline_s=finest["time_median_s"],
+                rtol_simulate=cheapest["ladder_value"], error_simulate=cheapest["error_F"],
+                t_simulate_s=cheapest["time_median_s"],
+                ratio=finest["time_median_s"] / cheapest["time_median_s"])
+
+
 def compare(ours, theirs, level):
     """Baseline time / simulate time at error ``level``, with its qualifier: '' at equal
     error, '>=' or '<=' when one side is only bounded (its cheapest run is already more
@@ -255,6 +278,7 @@ def speed_ratios(rows, scenes):
                     t_simulate_s=r["time_median_s"], t_baseline_s=t_base,
                     ratio=t_base / r["time_median_s"] if t_base else None,
                     qualifier="" if exact or t_base is None else "<="))
+            entry["at_baseline_finest"] = at_baseline_finest(ours, theirs)
             out[scene][base] = entry
     return out
 
@@ -363,6 +387,8 @@ def legend_label(method, order):
         return method
     if method in FIXED_LADDERS:
         return f"{method} (order {order:.2f})"
+    if order is None or not math.isfinite(order):
+        return f"{method} (every error below {FIT_FLOOR:g}: no fit)"
     return f"{method} (time ~ err^{order:.2f} below {FIT_MAX_ERROR:g})"
 
 
@@ -372,7 +398,7 @@ def plot(rows, scenes, fits, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    styles = {M_SIM: ("C0", "o", "-"), M_STEP: ("C1", "s", "-"), M_MESH: ("C1", "^", ":"),
+    styles = {M_SIM: ("C0", "o", "-"), M_SIM_STEP: ("C5", "P", "-"), M_STEP: ("C1", "s", "-"), M_MESH: ("C1", "^", ":"),
               M_NUMPY: ("C2", "d", "--"), M_LSODA: ("C3", "v", "-"), M_RADAU: ("C4", "<", "-"),
               M_SEED: ("k", "*", "")}
     fig, axes = plt.subplots(2, 2, figsize=(13, 10), constrained_layout=True)
@@ -397,7 +423,8 @@ def plot(rows, scenes, fits, path):
         ax.set_title(f"{scene}  (alpha = {SCENES[scene][0]:g}, chi = {SCENES[scene][1]:g})")
         ax.grid(True, which="major", alpha=0.3)
         ax.legend(fontsize=7, loc="lower left")  # the fast, accurate corner stays empty
-    fig.suptitle("Work-precision, single thread (dashed: target 1e-6 in 5 ms)")
+    fig.suptitle("Work-precision, single thread (dashed: target 1e-6 in 1 ms; errors below "
+                 "1e-16 drawn at 1e-16, off the left edge)")
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
@@ -413,7 +440,7 @@ def write_csv(rows, path):
 def print_summary(scenes, fits, ratios, targets):
     print(f"\n== Fitted orders (fixed-step ladders: order in N over the four finest runs; "
           f"others: exponent of\n   time vs error over the Pareto front below {FIT_MAX_ERROR:g})")
-    methods = [M_SIM, M_STEP, M_MESH, M_NUMPY, M_LSODA, M_RADAU]
+    methods = [M_SIM, M_SIM_STEP, M_STEP, M_MESH, M_NUMPY, M_LSODA, M_RADAU]
     print(f"  {'scene':<16}" + "".join(f"{m[:22]:>24}" for m in methods))
     for scene in scenes:
         print(f"  {scene:<16}" + "".join(f"{fmt(fits[scene][m], '24.2f')}" for m in methods))
@@ -460,6 +487,16 @@ def print_summary(scenes, fits, ratios, targets):
         f = targets["speed"][scene]["fine"]
         print(f"  {scene:<16} rtol={TARGET_FINE_RTOL:g}: err {f['error_F']:.1e} in "
               f"{1e3 * f['time_s']:.3g} ms = {f['ratio']:.2f}x -> {'MET' if f['met'] else 'MISSED'}")
+    print("\n== At the smallest error each solve_ivp ladder reaches: its time against simulate's "
+          "cheapest run\n   at least as accurate (a lower bound at equal error)")
+    for scene in scenes:
+        for base in (M_LSODA, M_RADAU):
+            f = ratios[scene][base]["at_baseline_finest"]
+            if f:
+                print(f"  {scene:<16} {base:<16} err {f['error_baseline']:.1e} in "
+                      f"{1e3 * f['t_baseline_s']:.4g} ms; simulate rtol {f['rtol_simulate']:.0e}: "
+                      f"err {f['error_simulate']:.1e} in {1e3 * f['t_simulate_s']:.3g} ms: "
+                      f">= {f['ratio']:.3g}x")
     print(f"\n== Target 3: >= {TARGET_SPEEDUP:g}x faster than solve_ivp at equal error")
     for key, v in targets["versus_solve_ivp"].items():
         verdict = ("MET" if v["met"] else
@@ -493,7 +530,10 @@ def main() -> None:
 
     # Warm every method once so that no timed call compiles or loads numba code.
     p0 = Problem.from_scene(scene_for_groups(1.0, 1e-4))
-    simulate(scene_for_groups(1.0, 1e-4))
+    warm = scene_for_groups(1.0, 1e-4)
+    simulate(warm)
+    simulate(warm.model_copy(update={"numerics": warm.numerics.model_copy(
+        update={"method": "stepper"})}))
     march_numpy(p0, frozen_detach_time(p0) / 25, 28)
     mol_detachment(p0, 25, 1e-4, "LSODA")
     mol_detachment(p0, 25, 1e-4, "Radau")
@@ -509,7 +549,7 @@ def main() -> None:
     fits = {}
     for s in scenes:
         fits[s] = {m: fitted_order(method_rows(rows, s, m))
-                   for m in (M_SIM, M_STEP, M_NUMPY, M_LSODA, M_RADAU)}
+                   for m in (M_SIM, M_SIM_STEP, M_STEP, M_NUMPY, M_LSODA, M_RADAU)}
         # The mesh ladder runs at the finest step: its error levels off at that step's error.
         step_floor = next(r["error_F"] for r in method_rows(rows, s, M_STEP)
                           if r["ladder_value"] == MESH_STEPS)

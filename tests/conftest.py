@@ -26,6 +26,7 @@ _FIRST = (
     "test_analytic.py",
     "test_agreement.py",
     "test_solver.py",
+    "test_quadrature.py",
 )
 
 

@@ -8,6 +8,7 @@ temporary file is removed by the next run; sweep workers die with their parent.
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import stat
@@ -214,8 +215,19 @@ def _wait_for(condition, timeout=60.0, what="condition"):
     raise AssertionError(f"timed out waiting for {what}")
 
 
+@functools.cache
+def _stepper_compiled() -> None:
+    """The onset stepper's kernels in numba's disk cache (the seed's default run no longer
+    compiles them: it is solved by quadrature), so that a long run's signal arrives while it
+    steps, not while it compiles."""
+    from pulloff.solvers import simulate
+
+    simulate(load_scene(SEED, overrides=["numerics.steps=64"]))
+
+
 def _long_run(out: Path) -> subprocess.Popen:
     """A run that takes a minute: a million fixed steps, history streamed into the file."""
+    _stepper_compiled()
     return _pulloff("run", SEED, "-o", out, "-q", "--no-plot", "--set", "numerics.steps=1000000")
 
 

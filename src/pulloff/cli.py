@@ -111,7 +111,7 @@ def _compile_notice(args, scene) -> None:
     kernel = solvers.route(scene).kernel
     if not getattr(args, "quiet", False) and kernel is not None and not cache_is_warm(kernel):
         print("pulloff: compiling the numba kernels for this machine (first run only: "
-              "5-15 s for an onset, 20-50 s for a moving contact edge)",
+              "2-5 s for an onset, 5-15 s with steps, 20-50 s for a moving contact edge)",
               file=sys.stderr, flush=True)
 
 
