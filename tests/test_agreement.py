@@ -4,38 +4,22 @@ The reference integrates the same model by nested adaptive quadrature of the exp
 solutions (a different method, sharing no code with the stepper) to ~1e-12.
 """
 
-import functools
 import math
 from pathlib import Path
 
 import pytest
 
-from pulloff.references.onset import reference_detachment
 from pulloff.io.scene_file import load_scene
 from pulloff.solvers import simulate
+from onset_helpers import METHODS, reference, with_method
 from test_solver import make_scene, scene_for_groups
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
 
-#: The onset's two methods (the quadrature by default, the stepper where steps are asked for):
-#: both are checked against the reference.
-METHODS = ("quadrature", "stepper")
-
-
-def with_method(scene, method):
-    return scene.model_copy(update={"numerics": scene.numerics.model_copy(
-        update={"method": method})})
-
-
-@functools.lru_cache(maxsize=None)
-def _reference(p):
-    return reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=1e-11)
-
-
 def _errors(res):
     p = res.problem
-    ref = _reference(p)
+    ref = reference(p, rtol=1e-11)
     assert ref["detached"]
     return max(abs(res.t_detach / ref["t_detach"] - 1.0),
                abs(res.F_contact_detach / ref["F_contact"] - 1.0),

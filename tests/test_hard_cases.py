@@ -4,16 +4,15 @@ Each runs at a modest rtol and is checked against the independent quadrature ref
 NaN, a bounded number of steps, the true error within rtol and the estimate not hiding it.
 """
 
-import functools
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from pulloff.references.onset import reference_detachment
 from pulloff.io.scene_file import load_scene
 from pulloff.solvers import simulate
+from onset_helpers import METHODS, reference
 
 HARD = Path(__file__).resolve().parents[1] / "configs" / "hard"
 DETACHING = sorted(p.stem for p in HARD.glob("*.yaml")
@@ -24,23 +23,14 @@ RTOL = 1e-5
 FLOOR = 1e-10
 
 
-#: The onset's two methods: every hard case is run by both.
-METHODS = ("quadrature", "stepper")
-
-
 def run(name, rtol=RTOL, method=None):
     overrides = [f"numerics.rtol={rtol}"] + ([f"numerics.method={method}"] if method else [])
     return simulate(load_scene(HARD / f"{name}.yaml", overrides=overrides))
 
 
-@functools.lru_cache(maxsize=None)
-def _reference(p, rtol):
-    return reference_detachment(p.G, p.eta, p.sigma_c, p.delta, p.a, p.v, p.h0, rtol=rtol)
-
-
 def largest_error(res, reference_rtol=1e-12):
     """The largest relative error of the onset time and forces against the reference."""
-    ref = _reference(res.problem, reference_rtol)
+    ref = reference(res.problem, reference_rtol)
     return max(abs(res.t_detach / ref["t_detach"] - 1),
                abs(res.F_contact_detach / ref["F_contact"] - 1),
                abs(res.F_total_detach / ref["F_total"] - 1))

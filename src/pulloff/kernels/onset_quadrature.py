@@ -30,13 +30,13 @@ import math
 import numpy as np
 from numba import njit
 
-#: The memory kernel is cut where ``exp(-k tau / c)`` falls below ``exp(-_DECAYS)``: e^-40
+#: The memory kernel is cut where ``exp(-k tau / c)`` falls below ``exp(-DECAYS)``: e^-40
 #: ~ 4e-18 of an integrand that is largest at ``tau = 0``.
-_DECAYS = 40.0
+DECAYS = 40.0
 #: Edges, in relaxation times ``c / k``, of the panels past the first relaxation time: each
 #: short enough for a Gauss rule of the level's order on ``exp(-y)`` (the error of ``n``
 #: points on a panel of length ``L`` is ~``(L/2)^(2n) / (2n)!`` of its weight).
-DECAY_EDGES = np.array([1.0, 2.0, 4.0, 8.0, 13.0, 19.0, 26.0, 33.0, _DECAYS])
+DECAY_EDGES = np.array([1.0, 2.0, 4.0, 8.0, 13.0, 19.0, 26.0, 33.0, DECAYS])
 #: Ratio of consecutive panels graded toward ``tau = 0``.
 _GRADING = 0.25
 
@@ -108,10 +108,10 @@ def memory_integral(k, c, H0, T, n_graded, nodes, weights):
     first relaxation time ``c / k`` (or all of ``[0, T]`` if shorter), then panels ending at
     ``DECAY_EDGES`` relaxation times, cut at ``T``; each with the rule ``nodes, weights``."""
     S = k * (H0 + T) + c
-    if T <= 0.0:
-        return 0.0
-    if c == 0.0:  # elastic: every element carries its current load
+    if c == 0.0:  # elastic: every element carries its current load, at t = 0 too
         return zone_kernel(S * S, 0.0) / k
+    if T <= 0.0:  # a damper cannot move at once (MODEL.md, settled questions)
+        return 0.0
     if k == 0.0:  # viscous: S is constant, the load too
         return T / c * zone_kernel(S * S, 0.0)
     relax = c / k

@@ -25,12 +25,16 @@ SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetQuadratureSolver(), OnsetSol
 
 def route(scene) -> Solver:
     """The solver that runs ``scene``; :class:`SceneError` naming every unsupported setting
-    otherwise."""
+    otherwise. A scene that names a ``numerics.method`` is told the problems of a solver of
+    that method (the one it asked for), or of one without a method."""
     best, best_rank = None, None
+    asked = scene.numerics.method
     for solver in SOLVERS:
         problems = solver.unsupported(scene)
         if not problems:
             return solver
+        if asked is not None and solver.method not in (None, asked):
+            continue
         settings = sum(line.startswith(("numerics.", "output.")) for line in problems)
         rank = (len(problems) - settings, settings)
         if best_rank is None or rank <= best_rank:

@@ -12,6 +12,8 @@ class Solver:
 
     name = ""
     summary = ""
+    #: How it solves (``numerics.method``: "quadrature" or "stepper"; None: a closed form).
+    method: str | None = None
     #: The numba kernel (``"module.function"`` under :mod:`pulloff.kernels`) whose cached
     #: copy says this solver's kernels are compiled; None: it compiles none.
     kernel: str | None = None
@@ -41,9 +43,10 @@ def stepper_settings(scene, solver: str) -> list[str]:
             "output.every)"))
     if scene.numerics.rtol < STEPPER_RTOL_FLOOR:
         out.append(problem(
-            "numerics.rtol", scene.numerics.rtol, f"below {STEPPER_RTOL_FLOOR:g} the {solver} "
-            "solver costs minutes; the quadrature onset (a Kelvin-Voigt flat punch to its "
-            "onset, no steps) goes to 1e-12"))
+            "numerics.rtol", scene.numerics.rtol, f"below {STEPPER_RTOL_FLOOR:g} a time "
+            "stepper costs minutes; only the quadrature onset goes to 1e-12 (a Kelvin-Voigt "
+            "flat punch to its onset, no numerics.steps, output.every or output.snapshots, "
+            "numerics.method not stepper)"))
     return out
 
 

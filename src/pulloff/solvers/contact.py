@@ -58,6 +58,7 @@ class ContactSolver(Solver):
     rheology, behind a rigid machine or a spring."""
 
     name = "contact"
+    method = "stepper"
     kernel = "contact.evaluate_step"
     summary = "moving contact edge and zone end: separation, finite punch, any rheology, machine"
 

@@ -405,6 +405,7 @@ class OnsetSolver(Solver):
     elastic) solid, a rigid machine pulling at constant speed; exact load history."""
 
     name = "onset"
+    method = "stepper"
     kernel = "onset.march"
     summary = "seed onset stepper (flat punch, external zone, Kelvin-Voigt, rigid pull)"
 

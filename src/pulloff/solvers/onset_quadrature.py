@@ -15,14 +15,17 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..kernels import onset_quadrature as kernels
+from ..model.scene import SceneError
 from .base import Solver, problem as problem_line
 from .frozen import frozen_detach_time
-from .onset import FoundationRun, assemble, detach_outputs, seed_onset_problems
+from .onset import FoundationRun, OnsetSolver, assemble, detach_outputs, seed_onset_problems
 from .problem import Problem
 
 #: Gauss-Legendre points per panel and panels graded toward the newest load, coarsest first.
@@ -36,9 +39,13 @@ _RULE_MARGIN = 10.0
 #: Chebyshev-Lobatto intervals of the history's first and largest interpolant.
 _FIRST_NODES = 16
 _MAX_NODES = 1024
+#: A nearly elastic solid's relaxation layer at ``t = 0`` thinner than this fraction of the
+#: pull is left out of the interpolant (:class:`Span`).
+_LAYER_FRACTION = 1e-3
 #: Rows of the history at most (``output.history_rows`` may ask for fewer): uniform in time, of
-#: an interpolant of 17-65 nodes, so more rows draw the same curve and cost ~0.1 ms per 1000
-#: (the SI columns and the closed forms of each row); a run at rtol 1e-6 costs ~0.3 ms.
+#: an interpolant of 17-65 nodes (up to 1025 where a note says it missed rtol), so more rows
+#: draw the same curve and cost ~0.1 ms per 1000 (the SI columns and the closed forms of each
+#: row); a run at rtol 1e-6 costs ~0.3 ms.
 HISTORY_ROWS = 257
 
 
@@ -110,13 +117,41 @@ class QuadratureRun:
         return root
 
 
-def history_interpolant(run: QuadratureRun, t_end: float, rtol: float):
-    """``(u nodes, gaps, estimate)``: the gap at Chebyshev-Lobatto nodes in ``u = sqrt(t /
-    t_end)``, doubled until the interpolant through every other node is within ``rtol`` (in
-    ``delta``) at the rest, or :data:`_MAX_NODES`; ``estimate`` is that largest difference."""
+@dataclass(frozen=True)
+class Span:
+    """The interpolant's interval ``[start, end]`` (dimensionless), with ``t = start + (end -
+    start) u^2``. ``start`` is 0, or past the relaxation layer of a nearly elastic solid lifted
+    at ``t = 0`` (its dampers let the preloaded elements catch up in ~``c / k``: a layer far
+    thinner than a row of the history, which no polynomial resolves; the rows before it are
+    evaluated one by one)."""
+
+    start: float
+    end: float
+
+    @classmethod
+    def for_problem(cls, problem: Problem, t_end: float) -> "Span":
+        k, c = problem.k, problem.c
+        if k > 0.0 and c > 0.0 and problem.h0_scaled > 0.0:
+            layer = kernels.DECAYS * c / k
+            if layer < _LAYER_FRACTION * t_end:
+                return cls(layer, t_end)
+        return cls(0.0, t_end)
+
+    def times(self, u: np.ndarray) -> np.ndarray:
+        return self.start + (self.end - self.start) * u * u
+
+    def nodes(self, t: np.ndarray) -> np.ndarray:
+        return np.sqrt(np.maximum(t - self.start, 0.0) / (self.end - self.start))
+
+
+def history_interpolant(run: QuadratureRun, span: Span, rtol: float):
+    """``(u nodes, gaps, estimate)``: the gap at Chebyshev-Lobatto nodes in ``u`` (see
+    :class:`Span`), doubled until the interpolant through every other node is within ``rtol``
+    (in ``delta``) at the rest, or :data:`_MAX_NODES`; ``estimate`` is that largest
+    difference."""
     n = _FIRST_NODES
     u = _lobatto(n)
-    values = run.gaps(t_end * u * u)
+    values = run.gaps(span.times(u))
     while True:
         odd = u[1::2]
         coarse = np.empty(odd.size)
@@ -126,10 +161,9 @@ def history_interpolant(run: QuadratureRun, t_end: float, rtol: float):
             return u, values, estimate
         n *= 2
         u_new = _lobatto(n)
-        fresh = u_new[1::2]
         merged = np.empty(n + 1)
         merged[::2] = values
-        merged[1::2] = run.gaps(t_end * fresh * fresh)
+        merged[1::2] = run.gaps(span.times(u_new[1::2]))
         u, values = u_new, merged
 
 
@@ -139,38 +173,66 @@ def _relative_change(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.max(np.abs(a - b) / scale))
 
 
-def _crossing(problem: Problem, m: int, t_end: float, bounded: bool, rtol: float):
+def _rounding(problem: Problem, t: float, slope: float) -> float:
+    """The relative error of an onset time ``t`` that the gap's rounding alone leaves: the
+    gap is a difference of terms of size ``(2/pi) h atan(s)``, whose last bits move the root
+    by their size over the slope. Large only where the onset comes right after ``t = 0`` (a
+    lift just short of the one that detaches at once): there no rule refines it."""
+    h = problem.h0_scaled + t
+    size = (2.0 / math.pi) * h * math.atan(problem.s_of(t))
+    return 4.0 * sys.float_info.epsilon * size / (abs(slope) * t) if slope and t > 0 else 0.0
+
+
+def _crossing(problem: Problem, m: int, span: Span, bounded: bool, rtol: float):
     """One try at rule ``m``: ``(t_detach or nan, estimate, history, runs)`` where
     ``history = (u nodes, gaps, interpolation estimate)`` and ``runs`` the two rules'
-    :class:`QuadratureRun` (for their counts). ``bounded``: ``t_end`` is the frozen onset,
+    :class:`QuadratureRun` (for their counts). ``bounded``: ``span.end`` is the frozen onset,
     where the exact gap is at least 1."""
     coarse, fine = QuadratureRun(problem, m), QuadratureRun(problem, m + 1)
-    u, values, spread = history_interpolant(coarse, t_end, rtol)
+    u, values, spread = history_interpolant(coarse, span, rtol)
+    history, runs = (u, values, spread), (coarse, fine)
     if bounded and values[-1] < 1.0:
         # The bound holds exactly, its rounding does not: an elastic solid (whose gap is the
-        # frozen one) reaches 1 within an ulp of t_end, on either side.
+        # frozen one) reaches 1 within an ulp of the end, on either side.
         values[-1] = 1.0
     above = np.nonzero(values >= 1.0)[0]
     if above.size == 0:
-        # No crossing before t_end: what is controlled is the gap there.
-        end = fine.gaps(np.array([t_end]))
-        return math.nan, _relative_change(values[-1:], end), (u, values, spread), (coarse, fine)
-    j = int(above[0])  # > 0: a gap of 1 at t = 0 never comes here (t_end = 0)
-    lo, hi = t_end * u[j - 1] ** 2, t_end * u[j] ** 2
+        # No crossing before the end: what is controlled is the gap there.
+        end = fine.gaps(np.array([span.end]))
+        return math.nan, _relative_change(values[-1:], end), history, runs
+    j = int(above[0])
+    if j == 0:
+        # The gap at the start within rounding of 1 where the frozen bound put it below: the
+        # onset is there. (A relaxation layer before a later start only lowers the gap.)
+        return span.start, 0.0, history, runs
+    t_at = span.times(u[max(j - 2, 0):j + 2])
+    lo, hi = span.times(u[j - 1:j + 1])
     t_coarse, slope = coarse.root_in(lo, hi, values[j - 1] - 1.0, values[j] - 1.0)
-    # Where the finer rule's root left the bracket the two rules differ by a node spacing:
-    # the widest bracket the history allows.
     last = j == u.size - 1
     t_fine = fine.root_near(t_coarse, slope, lo, hi, bounded and last)
     if math.isnan(t_fine):
-        t_fine = fine.root_near(t_coarse, slope, t_end * u[max(j - 2, 0)] ** 2,
-                                t_end * u[min(j + 1, u.size - 1)] ** 2,
+        # The finer rule's root left the bracket (a root on a node): the widest bracket the
+        # history allows.
+        t_fine = fine.root_near(t_coarse, slope, t_at[0], t_at[-1],
                                 bounded and j + 1 >= u.size - 1)
     if math.isnan(t_fine):
-        return t_coarse, math.inf, (u, values, spread), (coarse, fine)
+        return t_coarse, math.inf, history, runs
     estimate = _relative_change(detach_outputs(problem, t_coarse),
                                 detach_outputs(problem, t_fine))
-    return t_fine, estimate, (u, values, spread), (coarse, fine)
+    return t_fine, max(estimate, _rounding(problem, t_fine, slope)), history, runs
+
+
+def _rows(problem: Problem, run: QuadratureRun, span: Span, history, t_last: float, rows: int):
+    """``(t, gap)`` of the history: ``rows`` times uniform on ``[0, t_last]``, the gap from
+    the interpolant, or evaluated where a row lies before the interpolant's start."""
+    u, values, _ = history
+    t = np.linspace(0.0, t_last, max(2, rows))
+    gap = np.empty(t.size)
+    kernels.lobatto_interpolate(u, values, span.nodes(t), gap)
+    early = t < span.start
+    if np.any(early):
+        gap[early] = run.gaps(t[early])
+    return t, gap
 
 
 def quadrature_onset(problem: Problem, t_end: float, bounded: bool, rtol: float, rows: int):
@@ -183,20 +245,19 @@ def quadrature_onset(problem: Problem, t_end: float, bounded: bool, rtol: float,
     if t_end == 0.0:
         gap0 = float(kernels.gap(problem.k, problem.c, problem.h0_scaled, 0.0, *_rule(0)))
         return (FoundationRun(math.nan, np.zeros(1), np.array([gap0]), 0.0, 0, 0), 0.0, [])
+    span = Span.for_problem(problem, t_end)
     m = first_rule(rtol)
     while True:
-        t_detach, estimate, (u, values, spread), runs = _crossing(problem, m, t_end, bounded, rtol)
+        t_detach, estimate, history, runs = _crossing(problem, m, span, bounded, rtol)
         if estimate <= 0.5 * rtol or m + 2 >= len(_RULES):
             break
         m += 1
     notes = []
-    if spread > rtol:
-        notes.append(f"history: the gap's interpolant is within {spread:.2g} of delta (not "
-                     f"{rtol:g}) at {u.size} nodes")
+    if history[2] > rtol:
+        notes.append(f"history: the gap's interpolant is within {history[2]:.2g} of delta "
+                     f"(not {rtol:g}) at {history[0].size} nodes")
     t_last = t_end if math.isnan(t_detach) else t_detach
-    t = np.linspace(0.0, t_last, max(2, rows))
-    gap = np.empty(t.size)
-    kernels.lobatto_interpolate(u, values, np.sqrt(t / t_end), gap)
+    t, gap = _rows(problem, runs[0], span, history, t_last, rows)
     run = FoundationRun(math.nan, t, gap, t_detach, runs[1].nodes_per_gap(t_last),
                         sum(r.evaluations for r in runs))
     return run, estimate, notes
@@ -208,18 +269,20 @@ class OnsetQuadratureSolver(Solver):
     asks for no fixed steps, snapshots or ``output.every``."""
 
     name = "onset_quadrature"
+    method = "quadrature"
     kernel = "onset_quadrature.secant_root"  # compiled last
     summary = ("seed onset by quadrature over the load history (flat punch, external zone, "
                "Kelvin-Voigt, rigid pull; no steps)")
 
     def unsupported(self, scene) -> list[str]:
         out = seed_onset_problems(scene, "quadrature onset")
-        why = "the quadrature onset has no steps or element fields; the stepper has"
+        why = "the quadrature onset has no steps or element fields; the stepper has" + (
+            ": remove it, or numerics.method = quadrature"
+            if scene.numerics.method == "quadrature" else "")
         if scene.numerics.method == "stepper":
             out.append(problem_line("numerics.method", "stepper", "asks for the stepper"))
-        for key in ("steps", "max_elements"):
-            if getattr(scene.numerics, key) is not None:
-                out.append(problem_line(f"numerics.{key}", getattr(scene.numerics, key), why))
+        if scene.numerics.steps is not None:  # (max_elements comes only with steps)
+            out.append(problem_line("numerics.steps", scene.numerics.steps, why))
         if scene.output.every is not None:
             out.append(problem_line("output.every", scene.output.every, why))
         if scene.output.snapshots:
@@ -227,6 +290,10 @@ class OnsetQuadratureSolver(Solver):
         return out
 
     def solve(self, scene, observers):
+        if observers.snapshot_times or observers.every is not None:
+            # Observers given through the Python API, not by the scene routing saw: what
+            # they ask for needs the stepper's steps and fields.
+            return self._stepper(scene, observers)
         wall_start = time.perf_counter()
         problem = Problem.from_scene(scene)
         t_limit = (math.inf if scene.numerics.t_max is None
@@ -240,3 +307,14 @@ class OnsetQuadratureSolver(Solver):
                          f"{scene.numerics.rtol:g} with the finest rule")
         return assemble(scene, problem, run, estimate, math.nan, observers,
                         time.perf_counter() - wall_start, notes, False, solver=self.name)
+
+    @staticmethod
+    def _stepper(scene, observers):
+        """The onset stepper for observers that ask for snapshots or every n-th step; refused
+        (one line each) where the scene rules the stepper out."""
+        stepper = OnsetSolver()
+        problems = stepper.unsupported(scene)
+        if problems:
+            raise SceneError([f"{line} (the observers ask for snapshots or every n-th step, "
+                              "which only the onset stepper keeps)" for line in problems])
+        return stepper.solve(scene, observers)
