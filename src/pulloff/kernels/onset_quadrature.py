@@ -88,44 +88,91 @@ def zone_kernel(P, d):
 
 
 @njit(cache=True)
-def _panel(lo, hi, k, c, S, nodes, weights):
+def path_value(path, row, span, T):
+    """Row ``row`` (1: the lift ``H``, 2: ``S``) of a lift path at ``T``: the polynomial
+    through ``path[row]`` at the Chebyshev-Lobatto nodes ``path[0]`` of ``sqrt(T / span)``
+    in [0, 1] (barycentric form; the lift's start is smooth in the square root)."""
+    u = math.sqrt(max(T, 0.0) / span)
+    n = path.shape[1] - 1
+    num = 0.0
+    den = 0.0
+    for j in range(n + 1):
+        diff = u - path[0, j]
+        if diff == 0.0:
+            return path[row, j]
+        w = (0.5 if j == 0 or j == n else 1.0) * (1.0 if j % 2 == 0 else -1.0) / diff
+        num += w * path[row, j]
+        den += w
+    return num / den
+
+
+@njit(cache=True)
+def lift_and_zone(k, c, H0, path, span, T):
+    """``(H, S)`` at ``T``: the rigid pull's ``H0 + T`` and ``k H + c``, or a lift path's
+    (``path`` of shape ``(3, n + 1)``: nodes, ``H``, ``S``; shape ``(3, 0)``: rigid)."""
+    if path.shape[1] == 0:
+        return H0 + T, k * (H0 + T) + c
+    return path_value(path, 1, span, T), path_value(path, 2, span, T)
+
+
+@njit(cache=True)
+def _panel(lo, hi, k, c, S, T, path, span, nodes, weights):
     """``(1/c) int_lo^hi exp(-k tau/c) K(S(T - tau)^2, S^2) dtau`` by the Gauss rule
-    ``nodes, weights`` on [0, 1]."""
+    ``nodes, weights`` on [0, 1]; ``S(T - tau) = S - k tau`` on a rigid pull, else the
+    path's (never above ``S``: the zone only grows before the onset)."""
     width = hi - lo
     total = 0.0
+    rigid = path.shape[1] == 0
     for i in range(nodes.size):
         tau = lo + width * nodes[i]
-        k_tau = k * tau
-        s_then = S - k_tau
-        total += weights[i] * math.exp(-k_tau / c) * zone_kernel(s_then * s_then,
-                                                                  k_tau * (S + s_then))
+        if rigid:
+            k_tau = k * tau
+            s_then = S - k_tau
+            d = k_tau * (S + s_then)
+        else:
+            s_then = min(path_value(path, 2, span, T - tau), S)
+            d = (S - s_then) * (S + s_then)
+        total += weights[i] * math.exp(-k * tau / c) * zone_kernel(s_then * s_then, d)
     return total * width / c
 
 
 @njit(cache=True)
-def memory_integral(k, c, H0, T, n_graded, nodes, weights):
+def memory_integral(k, c, H0, path, span, T, n_graded, nodes, weights):
     """``I(T)`` of the module docstring: ``n_graded`` panels graded toward ``tau = 0`` over the
     first relaxation time ``c / k`` (or all of ``[0, T]`` if shorter), then panels ending at
-    ``DECAY_EDGES`` relaxation times, cut at ``T``; each with the rule ``nodes, weights``."""
-    S = k * (H0 + T) + c
+    ``DECAY_EDGES`` relaxation times, cut at ``T``; each with the rule ``nodes, weights``.
+    ``path``, ``span``: the lift (:func:`lift_and_zone`)."""
+    S = lift_and_zone(k, c, H0, path, span, T)[1]
     if c == 0.0:  # elastic: every element carries its current load, at t = 0 too
         return zone_kernel(S * S, 0.0) / k
     if T <= 0.0:  # a damper cannot move at once (MODEL.md, settled questions)
         return 0.0
-    if k == 0.0:  # viscous: S is constant, the load too
+    if k == 0.0 and path.shape[1] == 0:  # viscous, rigid: S is constant, the load too
         return T / c * zone_kernel(S * S, 0.0)
-    relax = c / k
-    hi = min(T, relax)
+    relax = c / k if k > 0.0 else math.inf
+    # A lift path starts with the punch catching up with the driver: a layer at tau = T,
+    # graded toward too wherever the memory reaches back that far.
+    end = T
+    if path.shape[1] > 0 and 0.5 * T < DECAYS * relax:
+        end = 0.5 * T
+    hi = min(end, relax)
     total = 0.0
     for j in range(n_graded):
         lo = hi * _GRADING if j < n_graded - 1 else 0.0
-        total += _panel(lo, hi, k, c, S, nodes, weights)
+        total += _panel(lo, hi, k, c, S, T, path, span, nodes, weights)
         hi = lo
     for j in range(DECAY_EDGES.size - 1):
         lo = DECAY_EDGES[j] * relax
-        if lo >= T:
+        if lo >= end:
             break
-        total += _panel(lo, min(T, DECAY_EDGES[j + 1] * relax), k, c, S, nodes, weights)
+        total += _panel(lo, min(end, DECAY_EDGES[j + 1] * relax), k, c, S, T, path, span,
+                        nodes, weights)
+    width = T - end
+    for j in range(n_graded if width > 0.0 else 0):
+        # [T - width r^j, T - width r^(j+1)], the last one reaching T
+        lo = T - width * _GRADING ** j
+        hi = T - width * _GRADING ** (j + 1) if j < n_graded - 1 else T
+        total += _panel(lo, hi, k, c, S, T, path, span, nodes, weights)
     return total
 
 
@@ -143,24 +190,24 @@ def nodes_per_gap(k, c, T, n_graded, n_points):
 
 
 @njit(cache=True)
-def gap(k, c, H0, T, n_graded, nodes, weights):
+def gap(k, c, H0, path, span, T, n_graded, nodes, weights):
     """The gap at the end of the zone at ``T``, in ``delta``."""
-    S = k * (H0 + T) + c
-    return (2.0 / math.pi) * ((H0 + T) * math.atan(S)
-                              - memory_integral(k, c, H0, T, n_graded, nodes, weights))
+    H, S = lift_and_zone(k, c, H0, path, span, T)
+    return (2.0 / math.pi) * (H * math.atan(S) - memory_integral(k, c, H0, path, span, T,
+                                                                 n_graded, nodes, weights))
 
 
 @njit(cache=True)
-def gaps(k, c, H0, times, n_graded, nodes, weights):
+def gaps(k, c, H0, path, span, times, n_graded, nodes, weights):
     """:func:`gap` at each of ``times``."""
     out = np.empty(times.size)
     for i in range(times.size):
-        out[i] = gap(k, c, H0, times[i], n_graded, nodes, weights)
+        out[i] = gap(k, c, H0, path, span, times[i], n_graded, nodes, weights)
     return out
 
 
 @njit(cache=True)
-def detach_time(k, c, H0, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
+def detach_time(k, c, H0, path, span, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
     """The root of ``gap = 1`` in ``[lo, hi]``, where ``g_lo = gap(lo) - 1 < 0 <= g_hi =
     gap(hi) - 1``, by the Illinois variant of regula falsi, to rounding: ``(T, slope,
     evaluations)`` with ``slope`` the last secant's ``d gap / dT``."""
@@ -176,7 +223,7 @@ def detach_time(k, c, H0, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
         if abs(mid - last) <= 2.2e-16 * mid:
             break  # the iterates stand still: rounding decides the last digit
         last = mid
-        g_mid = gap(k, c, H0, mid, n_graded, nodes, weights) - 1.0
+        g_mid = gap(k, c, H0, path, span, mid, n_graded, nodes, weights) - 1.0
         n_eval += 1
         if g_mid < 0.0:
             lo, g_lo = mid, g_mid
@@ -194,11 +241,11 @@ def detach_time(k, c, H0, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
 
 
 @njit(cache=True)
-def secant_root(k, c, H0, t0, slope, n_graded, nodes, weights):
+def secant_root(k, c, H0, path, span, t0, slope, n_graded, nodes, weights):
     """The root of ``gap = 1`` near ``t0`` by secants from ``t0`` with the first slope
     ``slope`` (a root of a nearby rule): ``(T, evaluations)``; ``T`` is nan where the
     iterates do not settle within 12 evaluations (the caller then brackets)."""
-    g0 = gap(k, c, H0, t0, n_graded, nodes, weights) - 1.0
+    g0 = gap(k, c, H0, path, span, t0, n_graded, nodes, weights) - 1.0
     n_eval = 1
     for _ in range(11):
         if g0 == 0.0 or not slope != 0.0:
@@ -206,7 +253,7 @@ def secant_root(k, c, H0, t0, slope, n_graded, nodes, weights):
         t1 = t0 - g0 / slope
         if abs(t1 - t0) <= 2.2e-16 * abs(t1):
             return t1, n_eval
-        g1 = gap(k, c, H0, t1, n_graded, nodes, weights) - 1.0
+        g1 = gap(k, c, H0, path, span, t1, n_graded, nodes, weights) - 1.0
         n_eval += 1
         if g1 != g0:
             slope = (g1 - g0) / (t1 - t0)

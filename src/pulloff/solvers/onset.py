@@ -384,10 +384,10 @@ def _field(sig_pre, U_pre, sig_born, U_born, n_born):
 # --------------------------------------------------------------------------------------------
 # Accuracy control and the SI result.
 
-def seed_onset_problems(scene, solver: str) -> list[str]:
+def seed_onset_problems(scene, solver: str, machine: bool = False) -> list[str]:
     """Problems of a scene for a solver of the seed's onset (Kelvin-Voigt or elastic, exact
-    history, to the onset)."""
-    out = flat_punch_pull(scene, solver)
+    history, to the onset; ``machine``: behind a machine spring too)."""
+    out = flat_punch_pull(scene, solver, machine=machine)
     if scene.material.kind not in ("kelvin_voigt", "elastic"):
         out.append(problem_line("material.kind", scene.material.kind,
                                 f"the {solver} solver takes Kelvin-Voigt and elastic solids"))
@@ -589,8 +589,10 @@ def _gap_difference(coarse: FoundationRun, fine: FoundationRun) -> float:
 
 
 def assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order: float,
-             observers, wall: float, notes: list, streamed: bool, solver: str = "onset") -> Result:
-    """The SI result of an onset run (``solver``: its name in the summary)."""
+             observers, wall: float, notes: list, streamed: bool, solver: str = "onset",
+             extra: dict | None = None) -> Result:
+    """The SI result of an onset run (``solver``: its name in the summary; ``extra``: more
+    summary values)."""
     T = problem.time_scale
     detached = not math.isnan(run.t_detach)
     t_hist, gap_hist = run.t, run.gap
@@ -616,6 +618,7 @@ def assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order
             zone_ratio_detach=float(zone_ratio(problem.s_of(td))),
             F_contact_detach=float(problem.contact_force(td)),
             F_total_detach=float(problem.total_force(td)))
+    summary.update(extra or {})
     snapshots = [(ts * T, problem.a * np.sqrt(1.0 + sig * sig), problem.delta * U)
                  for ts, sig, U in run.snapshots]
     return Result.build(summary, analytic.predictions(scene), si_history(problem, t_hist, gap_hist),

@@ -25,6 +25,7 @@ from ..kernels import onset_quadrature as kernels
 from ..model.scene import SceneError
 from .base import Solver, problem as problem_line
 from .frozen import frozen_detach_time
+from .machine_lift import machine_pull, relaxation_fraction
 from .onset import FoundationRun, OnsetSolver, assemble, detach_outputs, seed_onset_problems
 from .problem import Problem
 
@@ -42,6 +43,11 @@ _MAX_NODES = 1024
 #: A nearly elastic solid's relaxation layer at ``t = 0`` thinner than this fraction of the
 #: pull is left out of the interpolant (:class:`Span`).
 _LAYER_FRACTION = 1e-3
+#: Behind a spring, the shortest start (the punch catching up with the driver, as a fraction
+#: of the pull: :func:`.machine_lift.relaxation_fraction`) the quadrature takes.
+_MIN_RELAXATION = 1e-2
+#: The lift path of a rigid pull: none (the kernels' linear ``H0 + T``).
+RIGID = np.zeros((3, 0))
 #: Rows of the history at most (``output.history_rows`` may ask for fewer): uniform in time, of
 #: an interpolant of 17-65 nodes (up to 1025 where a note says it missed rtol), so more rows
 #: draw the same curve and cost ~0.1 ms per 1000 (the SI columns and the closed forms of each
@@ -79,23 +85,28 @@ class QuadratureRun:
 
     def __init__(self, problem: Problem, m: int):
         self.k, self.c, self.H0 = problem.k, problem.c, problem.h0_scaled
+        # The lift: a rigid pull's is linear; behind a spring, a path (machine_lift).
+        path = getattr(problem, "path", None)
+        self.lift = (RIGID, 1.0) if path is None else (path, problem.span)
         self.m = m
         self.rule = _rule(m)
         self.evaluations = 0
 
     def nodes_per_gap(self, t: float) -> int:
         graded, nodes, _ = self.rule
+        if self.k == 0.0 and self.c > 0.0 and self.lift[0].size:
+            return graded * nodes.size  # (a viscous solid's zone grows behind a spring)
         return kernels.nodes_per_gap(self.k, self.c, t, graded, nodes.size)
 
     def gaps(self, t: np.ndarray) -> np.ndarray:
         self.evaluations += t.size
-        return kernels.gaps(self.k, self.c, self.H0, np.ascontiguousarray(t, dtype=float),
-                            *self.rule)
+        return kernels.gaps(self.k, self.c, self.H0, *self.lift,
+                            np.ascontiguousarray(t, dtype=float), *self.rule)
 
     def root_in(self, lo, hi, g_lo, g_hi):
         """``(root, slope)`` in a bracket whose gaps minus 1 are ``g_lo < 0 <= g_hi``."""
-        root, slope, n = kernels.detach_time(self.k, self.c, self.H0, lo, hi, g_lo, g_hi,
-                                             *self.rule)
+        root, slope, n = kernels.detach_time(self.k, self.c, self.H0, *self.lift, lo, hi,
+                                             g_lo, g_hi, *self.rule)
         self.evaluations += n
         return root, slope
 
@@ -103,7 +114,8 @@ class QuadratureRun:
         """The root near ``t0`` (secants), or in ``[lo, hi]`` if they do not settle there;
         nan if ``[lo, hi]`` brackets none. ``bounded``: the gap is at least 1 at ``hi``
         (whatever its rounding says, see :func:`_crossing`)."""
-        root, n = kernels.secant_root(self.k, self.c, self.H0, t0, slope, *self.rule)
+        root, n = kernels.secant_root(self.k, self.c, self.H0, *self.lift, t0, slope,
+                                      *self.rule)
         self.evaluations += n
         if bounded and root > hi:
             return hi
@@ -178,8 +190,7 @@ def _rounding(problem: Problem, t: float, slope: float) -> float:
     gap is a difference of terms of size ``(2/pi) h atan(s)``, whose last bits move the root
     by their size over the slope. Large only where the onset comes right after ``t = 0`` (a
     lift just short of the one that detaches at once): there no rule refines it."""
-    h = problem.h0_scaled + t
-    size = (2.0 / math.pi) * h * math.atan(problem.s_of(t))
+    size = (2.0 / math.pi) * problem.lift(t) / problem.delta * math.atan(problem.s_of(t))
     return 4.0 * sys.float_info.epsilon * size / (abs(slope) * t) if slope and t > 0 else 0.0
 
 
@@ -243,7 +254,8 @@ def quadrature_onset(problem: Problem, t_end: float, bounded: bool, rtol: float,
     the finer one's root is reported, the history (``rows`` rows, uniform in time, to the
     onset or ``t_end``) is the coarser one's interpolant."""
     if t_end == 0.0:
-        gap0 = float(kernels.gap(problem.k, problem.c, problem.h0_scaled, 0.0, *_rule(0)))
+        gap0 = float(kernels.gap(problem.k, problem.c, problem.h0_scaled, RIGID, 1.0, 0.0,
+                                 *_rule(0)))
         return (FoundationRun(math.nan, np.zeros(1), np.array([gap0]), 0.0, 0, 0), 0.0, [])
     span = Span.for_problem(problem, t_end)
     m = first_rule(rtol)
@@ -275,7 +287,7 @@ class OnsetQuadratureSolver(Solver):
                "Kelvin-Voigt, rigid pull; no steps)")
 
     def unsupported(self, scene) -> list[str]:
-        out = seed_onset_problems(scene, "quadrature onset")
+        out = seed_onset_problems(scene, "quadrature onset", machine=True)
         why = "the quadrature onset has no steps or element fields; the stepper has" + (
             ": remove it, or numerics.method = quadrature"
             if scene.numerics.method == "quadrature" else "")
@@ -287,6 +299,17 @@ class OnsetQuadratureSolver(Solver):
             out.append(problem_line("output.every", scene.output.every, why))
         if scene.output.snapshots:
             out.append(problem_line("output.snapshots", scene.output.snapshots, why))
+        machine = getattr(scene.loading, "machine_stiffness", None)
+        if machine is not None and not out:
+            fraction = relaxation_fraction(Problem.from_scene(scene), machine)
+            if fraction < _MIN_RELAXATION:
+                # Measured on compliant_machine.yaml: at 1e3 N/m (5e-3) the gap's interpolant
+                # needs 1025 nodes for rtol 1e-10, at 5e3 N/m (1.2e-3) for 1e-6.
+                out.append(problem_line(
+                    "loading.machine_stiffness", machine, f"the spring lets the punch catch up "
+                    f"within {fraction:.1g} of the pull, a start too thin for the quadrature "
+                    f"onset (it takes {_MIN_RELAXATION:g} and more); the contact solver steps "
+                    "it"))
         return out
 
     def solve(self, scene, observers):
@@ -298,15 +321,29 @@ class OnsetQuadratureSolver(Solver):
         problem = Problem.from_scene(scene)
         t_limit = (math.inf if scene.numerics.t_max is None
                    else scene.numerics.t_max / problem.time_scale)
-        t_frozen = frozen_detach_time(problem, t_limit)
-        run, estimate, notes = quadrature_onset(problem, min(t_frozen, t_limit),
-                                                t_frozen <= t_limit, scene.numerics.rtol,
+        machine = scene.loading.machine_stiffness
+        if machine is None:
+            t_frozen = frozen_detach_time(problem, t_limit)
+            t_end, bounded, path_error = min(t_frozen, t_limit), t_frozen <= t_limit, 0.0
+        else:
+            problem, t_end, bounded, path_error = machine_pull(problem, machine, t_limit)
+        run, estimate, notes = quadrature_onset(problem, t_end, bounded, scene.numerics.rtol,
                                                 min(observers.history_rows, HISTORY_ROWS))
+        estimate = max(estimate, path_error)
         if not estimate <= scene.numerics.rtol:
             notes.append(f"not converged: error estimate {estimate:.2g} above rtol "
                          f"{scene.numerics.rtol:g} with the finest rule")
+        peaks = {}
+        if machine is not None and not math.isnan(run.t_detach):
+            # The zone grows until the onset (machine_pull checks it), and every force with it.
+            td = run.t_detach
+            peaks = dict(t_peak_contact=td * problem.time_scale,
+                         t_peak_total=td * problem.time_scale,
+                         F_peak_contact=float(problem.contact_force(td)),
+                         F_peak_total=float(problem.total_force(td)))
         return assemble(scene, problem, run, estimate, math.nan, observers,
-                        time.perf_counter() - wall_start, notes, False, solver=self.name)
+                        time.perf_counter() - wall_start, notes, False, solver=self.name,
+                        extra=peaks)
 
     @staticmethod
     def _stepper(scene, observers):
