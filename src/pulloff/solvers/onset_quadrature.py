@@ -9,6 +9,8 @@ the two roots' difference (that of the coarser rule, so a cautious one). The his
 polynomial interpolant of the gap in ``u = sqrt(t / t_end)`` (the gap has a ``t^2 log t`` term
 at ``t = 0``, smooth in ``u``) on Chebyshev-Lobatto nodes, doubled until the interpolant of
 half the nodes is within ``rtol`` of the other half: its nodes bracket the first crossing.
+Behind a machine spring the lift and the zone come from :mod:`.machine_lift` instead of the
+rigid pull's ``H0 + T``.
 """
 
 from __future__ import annotations
@@ -277,14 +279,14 @@ def quadrature_onset(problem: Problem, t_end: float, bounded: bool, rtol: float,
 
 class OnsetQuadratureSolver(Solver):
     """The seed scene to its onset by quadrature over the load history (Kelvin-Voigt or
-    elastic, flat punch, zone outside, rigid pull), without steps: the default where a scene
-    asks for no fixed steps, snapshots or ``output.every``."""
+    elastic, flat punch, zone outside, a rigid pull or one through a machine spring), without
+    steps: the default where a scene asks for no fixed steps, snapshots or ``output.every``."""
 
     name = "onset_quadrature"
     method = "quadrature"
     kernel = "onset_quadrature.secant_root"  # compiled last
     summary = ("seed onset by quadrature over the load history (flat punch, external zone, "
-               "Kelvin-Voigt, rigid pull; no steps)")
+               "Kelvin-Voigt, rigid or through a machine spring; no steps)")
 
     def unsupported(self, scene) -> list[str]:
         out = seed_onset_problems(scene, "quadrature onset", machine=True)
