@@ -323,33 +323,67 @@ def test_the_onset_behind_a_spring_is_the_moving_edge_references(case, k_m):
         assert res.error_estimate >= max(errors) / 10.0 or max(errors) <= floor
 
 
-def test_an_elastic_solid_behind_a_spring_detaches_in_its_elastic_state():
+@pytest.mark.parametrize("k_m", [0.01, 100.0, 1e4, 1e6])
+def test_an_elastic_solid_behind_a_spring_detaches_in_its_elastic_state(k_m):
     """Elastic, the onset's state does not depend on how the punch got there: the rigid
     pull's lift and force (the elastic closed form), reached when the driver has also
-    stretched the spring by that force."""
-    res = simulate(load_scene(MACHINE, overrides=["material.eta=0", "numerics.rtol=1e-10"]))
+    stretched the spring by that force. (A review found stiff springs raising an error, the
+    collocation's inverse clipped at a compressed spring, and the time 2e-6 off, the path's
+    check blind between nodes where the collocation is exact at them.)"""
+    res = simulate(load_scene(MACHINE, overrides=["material.eta=0", "numerics.rtol=1e-10",
+                                                  f"loading.machine_stiffness={k_m}"]))
     rigid = simulate(load_scene(MACHINE, overrides=["material.eta=0", "numerics.rtol=1e-10",
                                                     "loading.machine_stiffness=null"]))
     assert res.summary["solver"] == "onset_quadrature"
-    assert res.F_total_detach == pytest.approx(res.analytic["elastic_F_total"], rel=1e-13)
+    # measured: within 2.2e-13 (F) and 5.6e-14 (t) up to 1e6 N/m
+    assert res.F_total_detach == pytest.approx(res.analytic["elastic_F_total"], rel=1e-12)
     assert res.h_detach == pytest.approx(rigid.h_detach, rel=1e-12)
     stretch = res.F_total_detach / res.problem.machine_stiffness
     assert res.t_detach == pytest.approx((res.h_detach + stretch) / res.problem.v, rel=1e-12)
 
 
-def test_a_viscous_solid_behind_a_spring_matches_the_stepper():
-    """``G = 0``: no memory decays, so the start (the punch catching up with the driver)
-    weighs on the gap to the onset; the quadrature grades toward it too. Measured 3.9e-10
-    from the contact stepper at rtol 1e-7 (its estimate 4.5e-8; 130 s there)."""
-    res = simulate(load_scene(MACHINE, overrides=["material.G=0", "numerics.rtol=1e-10"]))
-    assert res.summary["solver"] == "onset_quadrature" and not res.notes
-    assert res.t_detach == pytest.approx(0.04773271938547097, rel=1e-7)
-    assert res.F_total_detach == pytest.approx(8.105827644877648e-05, rel=1e-9)
+@pytest.mark.parametrize("overrides", [["material.G=0"], ["loading.machine_stiffness=1e4"]])
+def test_a_spring_that_dominates_the_solid_goes_to_the_contact_solver(overrides):
+    """Where the spring is stiffer than the solid at the start (``kappa/2 > 10 k``; any spring
+    on a viscous solid) the punch catches up with the driver in a layer the lift's
+    collocation did not resolve (a review: 16 failures in 400 random scenes): the contact
+    solver steps those, as before."""
+    assert route(load_scene(MACHINE, overrides=overrides)).name == "contact"
 
 
-def test_a_stiff_spring_goes_to_the_contact_solver_and_quadrature_refuses_it():
-    scene = load_scene(MACHINE, overrides=["loading.machine_stiffness=1e4"])
-    assert route(scene).name == "contact"
+def test_quadrature_refuses_a_stiff_spring_with_one_line():
     with pytest.raises(SceneError, match="loading.machine_stiffness = 1e4: the spring"):
         load_scene(MACHINE, overrides=["loading.machine_stiffness=1e4",
                                        "numerics.method=quadrature"])
+
+
+def test_observers_asking_for_steps_behind_a_spring_get_the_contact_solver():
+    """(A review found them refused: they were sent to the onset stepper, which takes no
+    spring.)"""
+    from pulloff.solvers.observers import Observers
+
+    res = simulate(load_scene(MACHINE, overrides=["numerics.rtol=1e-3"]),
+                   observers=Observers(every=5))
+    assert res.summary["solver"] == "contact"
+
+
+@pytest.mark.parametrize("eta,k_m,t_ref,F_ref", [
+    (1e9, 1.0, 94.73721215437706, 0.09473195375911259),
+    (3e7, 0.01, 126.10211016923567, 0.001260946402526047),
+    (1e8, 1.0, 21.48279871551, 0.0214774500375),
+])
+def test_a_slow_solid_behind_a_soft_spring_detaches_where_an_independent_solver_says(
+        eta, k_m, t_ref, F_ref):
+    """Large damping behind a soft spring: the rigid pull's span overshot the onset by orders
+    of magnitude, and the path spent its nodes past it (a review found onsets 1.4-240x early
+    with estimates ~1e-12). The references are the review's own solver (its ODE path and a
+    nested quadrature of the gap, /tmp), good to ~1e-11 (two of its runs differ by 1.2e-11
+    on the third scene). Measured: within 7.7e-11, 1.4e-11 and 1e-11."""
+    res = simulate(load_scene(MACHINE, overrides=[f"material.eta={eta}",
+                                                  f"loading.machine_stiffness={k_m}"]))
+    assert res.summary["solver"] == "onset_quadrature" and not res.notes
+    assert res.t_detach == pytest.approx(t_ref, rel=1e-9)
+    assert res.F_total_detach == pytest.approx(F_ref, rel=1e-9)
+    h = res.history
+    balance = k_m * (res.problem.v * h["t"] - h["h"]) - h["F_total"]
+    assert np.max(np.abs(balance)) <= 1e-12 * np.max(h["F_total"])
