@@ -280,3 +280,22 @@ def lobatto_interpolate(u_nodes, values, u, out):
             num += w * values[j]
             den += w
         out[i] = values[exact] if exact >= 0 else num / den
+
+
+@njit(cache=True)
+def zone_of_force(y, out):
+    """``S = Phi^-1(y)`` for each of ``y``, ``Phi(S) = S + (1 + S^2) atan(S)`` (odd, convex
+    for ``S >= 0``): Newton from above, written to ``out``. The lift behind a machine spring
+    inverts it ~100 times a run (:mod:`pulloff.solvers.machine_lift`)."""
+    for i in range(y.size):
+        target = abs(y[i])
+        # Phi(S) >= 2 S and >= (pi/2) S^2: the smaller inverse bounds S from above.
+        S = min(0.5 * target, math.sqrt(2.0 * target / math.pi))
+        for _ in range(60):
+            atan = math.atan(S)
+            step = (S + (1.0 + S * S) * atan - target) / (2.0 + 2.0 * S * atan)
+            S -= step
+            if abs(step) <= 4e-16 * S or S <= 0.0:
+                break
+        S = max(S, 0.0)
+        out[i] = S if y[i] >= 0.0 else -S

@@ -37,19 +37,13 @@ def zone_force(S):
 
 
 def zone_of_force(y):
-    """``Phi^-1(y)`` (Newton from above: ``Phi`` is convex for ``S >= 0``, and odd, so a
-    compressed spring's ``y < 0`` gives ``-Phi^-1(-y)``: Newton's trial lifts may ask for it,
-    and a clipped inverse there stalled Newton on a stiff spring)."""
+    """``Phi^-1(y)`` (:func:`pulloff.kernels.onset_quadrature.zone_of_force`; ``Phi`` is odd,
+    so a compressed spring's ``y < 0`` gives ``-Phi^-1(-y)``: Newton's trial lifts may ask
+    for it, and a clipped inverse there stalled Newton on a stiff spring)."""
     y = np.asarray(y, dtype=float)
-    sign, y = np.sign(y), np.abs(y)
-    # Phi(S) >= 2 S and >= (pi/2) S^2: the smaller of the two inverses is an upper bound.
-    S = np.minimum(0.5 * y, np.sqrt(2.0 * y / math.pi))
-    for _ in range(60):
-        step = (zone_force(S) - y) / (2.0 + 2.0 * S * np.arctan(S))
-        S = S - step
-        if np.all(np.abs(step) <= 4e-16 * np.maximum(S, 1e-300)):
-            break
-    return sign * np.maximum(S, 0.0)
+    out = np.empty(y.shape)
+    kernels.zone_of_force(y.reshape(-1), out.reshape(-1))
+    return out
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -84,18 +78,20 @@ class MachinePull(Problem):
         return 4.0 * self.sigma_c * self.a * self.a * self.s_of(t)
 
 
-def machine_pull(problem: Problem, machine_stiffness: float, t_limit: float):
+def machine_pull(problem: Problem, machine_stiffness: float, t_limit: float,
+                 rtol: float = 1e-10):
     """``(MachinePull, t_end, bounded, estimate)``: the lift path from ``T = 0`` past the
     frozen onset, ``t_end`` (``bounded``; it bounds the exact onset from above while the zone
     grows, as on a rigid pull), or to ``t_limit``. ``estimate``: the path's error relative to
-    its largest ``S`` (its last change with the nodes doubled). Raises ValueError where the
+    its largest ``S`` (its last change with the nodes doubled), brought below ``1e-3 rtol``
+    (at least 1e-13). Raises ValueError where the
     zone stops growing before the end (the quadrature assumes it grows)."""
     k, c = problem.k, problem.c
     kappa = kappa_of(problem, machine_stiffness)
     first = _first_span(problem, kappa)
     span = min(first, t_limit)
     for _ in range(200):
-        path, estimate = _path(k, c, kappa, span)
+        path, estimate = _path(k, c, kappa, span, max(1e-13, 1e-3 * rtol))
         t_end = _frozen_onset(k, c, path, span)
         if t_end is not None and t_end < 0.5 * span:
             # The first span (the rigid pull's) can overshoot a soft spring's onset by orders
@@ -180,11 +176,11 @@ def _frozen_onset(k, c, path, span):
     return hi
 
 
-def _path(k, c, kappa, span):
+def _path(k, c, kappa, span, tol):
     """``(path, estimate)``: the lift's ODE by Chebyshev collocation in ``u = sqrt(T /
     span)`` (the lift's relaxation at the start then takes half the nodes it takes in
     ``T``), the nodes doubled from 16 until the solution at the shared nodes changes by at
-    most ~1e-13 of its largest ``S`` (or :data:`_MAX_NODES`)."""
+    most ``tol`` of its largest ``S`` (or :data:`_MAX_NODES`)."""
     n, previous = _FIRST_NODES, None
     while True:
         u, D = _lobatto_differentiation(n)
@@ -210,7 +206,7 @@ def _path(k, c, kappa, span):
         change = float(np.max(np.abs(half - S[1::2]))) / scale
         if previous is not None:
             change = max(change, float(np.max(np.abs(S[::2] - previous[2]))) / scale)
-            if change <= 1e-13 or n >= _MAX_NODES:
+            if change <= tol or n >= _MAX_NODES:
                 return np.vstack([u, H, S]), change
         previous, n = (u, H, S), 2 * n
 

@@ -340,7 +340,8 @@ class OnsetQuadratureSolver(Solver):
             t_frozen = frozen_detach_time(problem, t_limit)
             t_end, bounded, path_error = min(t_frozen, t_limit), t_frozen <= t_limit, 0.0
         else:
-            problem, t_end, bounded, path_error = machine_pull(problem, machine, t_limit)
+            problem, t_end, bounded, path_error = machine_pull(problem, machine, t_limit,
+                                                               scene.numerics.rtol)
         run, estimate, notes = quadrature_onset(problem, t_end, bounded, scene.numerics.rtol,
                                                 min(observers.history_rows, HISTORY_ROWS))
         estimate = max(estimate, path_error)
