@@ -1013,3 +1013,16 @@ def test_a_remembered_jacobian_solves_a_linear_balance_in_one_step_and_a_stale_o
                                          np.ones(2))
     assert np.all(np.abs(r) <= 1e-12) and len(calls) <= 6
     np.testing.assert_allclose(calls[-1], [2.0, 1.0], rtol=1e-12)
+
+
+def test_observers_asking_for_steps_behind_a_spring_get_the_contact_solver():
+    """The onset behind a spring is solved by quadrature (tests/test_quadrature.py); API
+    observers asking for steps get the contact solver (a review found them refused: they were
+    sent to the onset stepper, which takes no spring). Here, not there: it compiles the
+    moving-edge kernels (tests/conftest.py)."""
+    from pulloff.solvers.observers import Observers
+
+    scene = load_scene(CONFIGS / "compliant_machine.yaml", overrides=["numerics.rtol=1e-3"])
+    res = solvers.simulate(scene, observers=Observers(every=5))
+    assert res.summary["solver"] == "contact"
+

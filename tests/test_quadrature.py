@@ -357,16 +357,6 @@ def test_quadrature_refuses_a_stiff_spring_with_one_line():
                                        "numerics.method=quadrature"])
 
 
-def test_observers_asking_for_steps_behind_a_spring_get_the_contact_solver():
-    """(A review found them refused: they were sent to the onset stepper, which takes no
-    spring.)"""
-    from pulloff.solvers.observers import Observers
-
-    res = simulate(load_scene(MACHINE, overrides=["numerics.rtol=1e-3"]),
-                   observers=Observers(every=5))
-    assert res.summary["solver"] == "contact"
-
-
 @pytest.mark.parametrize("eta,k_m,t_ref,F_ref", [
     (1e9, 1.0, 94.73721215437706, 0.09473195375911259),
     (3e7, 0.01, 126.10211016923567, 0.001260946402526047),
