@@ -53,7 +53,6 @@ def format_table(record: dict, title: str | None = None) -> str:
     ``F_contact`` (the seed's own definition of the pull-off force, eq. 48).
     """
     s = record["summary"]
-    an = record["analytic"]
     lines = []
     if title:
         lines.append(title)
@@ -69,57 +68,10 @@ def format_table(record: dict, title: str | None = None) -> str:
         lines.append(f"  no detachment before t_max = {_fmt(s['t_end'], 's')} "
                      f"(last simulated time); raise numerics.t_max to continue")
     else:
-        rows = [
-            ("detachment time t", s["t_detach"], "s"),
-            ("lift h", s["h_detach"], "m"),
-            ("cohesive-zone end b", s["b_detach"], "m"),
-            ("(b - a)/a", s.get("zone_ratio_detach"), ""),
-            ("F_contact (eq. 48)", s["F_contact_detach"], "N"),
-            ("F_total (with zone)", s["F_total_detach"], "N"),
-        ]
-        lines.append("  simulation")
-        for label, value, unit in rows:
-            lines.append(f"    {label:<28} {_fmt(value, unit):>16}")
-        lines.append(f"    {'error estimate (relative)':<28} {_fmt(s['error_estimate']):>16}")
-        F = s["F_contact_detach"]
-        t = s["t_detach"]
-        lines.append("  closed forms                           value   vs simulation")
-        compare = [
-            ("seed linearised t (eq. 53)", an.get("seed_linearised_t_detach"), "s", t),
-            ("seed linearised F (eq. 48)", an.get("seed_linearised_F"), "N", F),
-            (f"seed closed form F ({an.get('seed_closed_form_branch', '?')})",
-             an.get("seed_closed_form_F"), "N", F),
-            ("Kendall F (eq. 95)", an.get("kendall_F"), "N", F),
-            ("viscous F = 8 eta v a (eq. 96)", an.get("viscous_F"), "N", F),
-            ("elastic MDR-Dugdale F_contact", an.get("elastic_F_contact"), "N", F),
-            ("elastic MDR-Dugdale F_total", an.get("elastic_F_total"), "N",
-             s["F_total_detach"]),
-        ]
-        instant = an.get("elastic_instant_F_total")
-        if isinstance(instant, float) and math.isfinite(instant):
-            compare.append(("elastic, instantaneous modulus F_total", instant, "N",
-                            s["F_total_detach"]))
-        for label, value, unit, ref in compare:
-            lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
+        lines.extend(_onset_lines(s, record["analytic"]))
     if (s.get("until") == "separation" and record.get("complete", True)
             and not math.isfinite(s.get("F_pulloff", math.nan))):
-        lines.append("  past the onset (model.until = separation)")
-        F_on = s["F_total_detach"]
-        rows = [
-            ("separation time", _fmt(s.get("t_separation"), "s")),
-            ("peak F_contact", f"{_fmt(s.get('F_peak_contact'), 'N')} at "
-                               f"{_fmt(s.get('t_peak_contact'), 's')}"),
-            ("peak F_total", f"{_fmt(s.get('F_peak_total'), 'N')} at "
-                             f"{_fmt(s.get('t_peak_total'), 's')}"),
-            ("peak / onset F_total", _rel(s.get("F_peak_total"), F_on)),
-        ]
-        order = s.get("observed_order")
-        if isinstance(order, float) and math.isfinite(order):
-            # A number only where the last three levels converge; elsewhere it would mislead.
-            rows.append(("observed order (step)", _fmt(order) if order >= 0.5 else
-                         "none: levels not converging"))
-        for label, text in rows:
-            lines.append(f"    {label:<28} {text:>30}")
+        lines.extend(_separation_lines(s))
     for note in filter(None, str(s.get("notes", "")).split("; ")):
         lines.append(f"  note: {note}")
     rows = record.get("history_rows_in_file", len(record["history"]["t"]))
@@ -129,6 +81,61 @@ def format_table(record: dict, title: str | None = None) -> str:
     lines.append(f"  {work}, history rows {rows}, wall time {s['wall_time'] * 1e3:.1f} ms")
     return "\n".join(lines)
 
+
+def _onset_lines(s: dict, an: dict) -> list[str]:
+    """The onset's values and the closed forms against them."""
+    rows = [
+        ("detachment time t", s["t_detach"], "s"),
+        ("lift h", s["h_detach"], "m"),
+        ("cohesive-zone end b", s["b_detach"], "m"),
+        ("(b - a)/a", s.get("zone_ratio_detach"), ""),
+        ("F_contact (eq. 48)", s["F_contact_detach"], "N"),
+        ("F_total (with zone)", s["F_total_detach"], "N"),
+    ]
+    lines = ["  simulation"]
+    for label, value, unit in rows:
+        lines.append(f"    {label:<28} {_fmt(value, unit):>16}")
+    lines.append(f"    {'error estimate (relative)':<28} {_fmt(s['error_estimate']):>16}")
+    F = s["F_contact_detach"]
+    t = s["t_detach"]
+    lines.append("  closed forms                           value   vs simulation")
+    compare = [
+        ("seed linearised t (eq. 53)", an.get("seed_linearised_t_detach"), "s", t),
+        ("seed linearised F (eq. 48)", an.get("seed_linearised_F"), "N", F),
+        (f"seed closed form F ({an.get('seed_closed_form_branch', '?')})",
+         an.get("seed_closed_form_F"), "N", F),
+        ("Kendall F (eq. 95)", an.get("kendall_F"), "N", F),
+        ("viscous F = 8 eta v a (eq. 96)", an.get("viscous_F"), "N", F),
+        ("elastic MDR-Dugdale F_contact", an.get("elastic_F_contact"), "N", F),
+        ("elastic MDR-Dugdale F_total", an.get("elastic_F_total"), "N", s["F_total_detach"]),
+    ]
+    instant = an.get("elastic_instant_F_total")
+    if isinstance(instant, float) and math.isfinite(instant):
+        compare.append(("elastic, instantaneous modulus F_total", instant, "N",
+                        s["F_total_detach"]))
+    for label, value, unit, ref in compare:
+        lines.append(f"    {label:<34} {_fmt(value, unit):>14}   {_rel(value, ref):>10}")
+    return lines
+
+
+def _separation_lines(s: dict) -> list[str]:
+    """A run past the onset: separation, peaks, and the ladder's order."""
+    F_on = s["F_total_detach"]
+    rows = [
+        ("separation time", _fmt(s.get("t_separation"), "s")),
+        ("peak F_contact", f"{_fmt(s.get('F_peak_contact'), 'N')} at "
+                           f"{_fmt(s.get('t_peak_contact'), 's')}"),
+        ("peak F_total", f"{_fmt(s.get('F_peak_total'), 'N')} at "
+                         f"{_fmt(s.get('t_peak_total'), 's')}"),
+        ("peak / onset F_total", _rel(s.get("F_peak_total"), F_on)),
+    ]
+    order = s.get("observed_order")
+    if isinstance(order, float) and math.isfinite(order):
+        # A number only where the last three levels converge; elsewhere it would mislead.
+        rows.append(("observed order (step)", _fmt(order) if order >= 0.5 else
+                     "none: levels not converging"))
+    return ["  past the onset (model.until = separation)"] + [
+        f"    {label:<28} {text:>30}" for label, text in rows]
 
 
 def _path_lines(record) -> list[str]:
