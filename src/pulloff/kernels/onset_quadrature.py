@@ -87,23 +87,43 @@ def zone_kernel(P, d):
         3.0 * math.sqrt((1.0 + P) * d))
 
 
+def lobatto_nodes(n: int) -> np.ndarray:
+    """The ``n + 1`` Chebyshev-Lobatto nodes of [0, 1], ``(1 - cos(pi j / n)) / 2``, ascending,
+    0 and 1 exact: the nodes of every interpolant here (plain Python, kept per ``n``)."""
+    if n not in _LOBATTO:
+        u = 0.5 * (1.0 - np.cos(np.pi * np.arange(n + 1) / n))
+        u[0], u[-1] = 0.0, 1.0
+        _LOBATTO[n] = u
+    return _LOBATTO[n]
+
+
+_LOBATTO: dict = {}
+
+
+@njit(cache=True)
+def _barycentric(u_nodes, values, u):
+    """The polynomial through ``values`` at the Chebyshev-Lobatto nodes ``u_nodes`` of
+    [0, 1] (:func:`lobatto_nodes`), at ``u``: the barycentric formula, stable at every
+    degree."""
+    n = u_nodes.size - 1
+    num = 0.0
+    den = 0.0
+    for j in range(n + 1):
+        diff = u - u_nodes[j]
+        if diff == 0.0:
+            return values[j]
+        w = (0.5 if j == 0 or j == n else 1.0) * (1.0 if j % 2 == 0 else -1.0) / diff
+        num += w * values[j]
+        den += w
+    return num / den
+
+
 @njit(cache=True)
 def path_value(path, row, span, T):
     """Row ``row`` (1: the lift ``H``, 2: ``S``) of a lift path at ``T``: the polynomial
     through ``path[row]`` at the Chebyshev-Lobatto nodes ``path[0]`` of ``sqrt(T / span)``
-    in [0, 1] (barycentric form; the lift's start is smooth in the square root)."""
-    u = math.sqrt(max(T, 0.0) / span)
-    n = path.shape[1] - 1
-    num = 0.0
-    den = 0.0
-    for j in range(n + 1):
-        diff = u - path[0, j]
-        if diff == 0.0:
-            return path[row, j]
-        w = (0.5 if j == 0 or j == n else 1.0) * (1.0 if j % 2 == 0 else -1.0) / diff
-        num += w * path[row, j]
-        den += w
-    return num / den
+    in [0, 1] (the lift's start is smooth in the square root)."""
+    return _barycentric(path[0], path[row], math.sqrt(max(T, 0.0) / span))
 
 
 @njit(cache=True)
@@ -138,10 +158,8 @@ def _panel(lo, hi, k, c, S, T, path, span, nodes, weights):
 
 @njit(cache=True)
 def memory_integral(k, c, H0, path, span, T, n_graded, nodes, weights):
-    """``I(T)`` of the module docstring: ``n_graded`` panels graded toward ``tau = 0`` over the
-    first relaxation time ``c / k`` (or all of ``[0, T]`` if shorter), then panels ending at
-    ``DECAY_EDGES`` relaxation times, cut at ``T``; each with the rule ``nodes, weights``.
-    ``path``, ``span``: the lift (:func:`lift_and_zone`)."""
+    """``I(T)`` of the module docstring (:func:`_over_panels`); ``path``, ``span``: the lift
+    (:func:`lift_and_zone`)."""
     S = lift_and_zone(k, c, H0, path, span, T)[1]
     if c == 0.0:  # elastic: every element carries its current load, at t = 0 too
         return zone_kernel(S * S, 0.0) / k
@@ -149,9 +167,26 @@ def memory_integral(k, c, H0, path, span, T, n_graded, nodes, weights):
         return 0.0
     if k == 0.0 and path.shape[1] == 0:  # viscous, rigid: S is constant, the load too
         return T / c * zone_kernel(S * S, 0.0)
+    return _over_panels(k, c, S, T, path, span, n_graded, nodes, weights, False)
+
+
+@njit(cache=True)
+def nodes_per_gap(k, c, H0, path, span, T, n_graded, nodes, weights):
+    """Gauss nodes of one :func:`memory_integral` at ``T`` (none for its closed forms)."""
+    if c == 0.0 or T <= 0.0 or (k == 0.0 and path.shape[1] == 0):
+        return 0
+    return int(_over_panels(k, c, 0.0, T, path, span, n_graded, nodes, weights, True))
+
+
+@njit(cache=True)
+def _over_panels(k, c, S, T, path, span, n_graded, nodes, weights, count):
+    """The sum of :func:`_panel` over the layout (or, with ``count``, its number of nodes):
+    ``n_graded`` panels graded toward ``tau = 0`` over the first relaxation time ``c / k``
+    (or all of ``[0, T]`` if shorter), then panels ending at ``DECAY_EDGES`` relaxation
+    times, cut at ``T``; behind a lift path whose memory reaches back to the pull's start,
+    the first half only, and ``n_graded`` panels graded toward ``tau = T`` on the rest."""
     relax = c / k if k > 0.0 else math.inf
-    # A lift path starts with the punch catching up with the driver: a layer at tau = T,
-    # graded toward too wherever the memory reaches back that far.
+    # A lift path starts with the punch catching up with the driver: a layer at tau = T.
     end = T
     if path.shape[1] > 0 and 0.5 * T < DECAYS * relax:
         end = 0.5 * T
@@ -159,34 +194,23 @@ def memory_integral(k, c, H0, path, span, T, n_graded, nodes, weights):
     total = 0.0
     for j in range(n_graded):
         lo = hi * _GRADING if j < n_graded - 1 else 0.0
-        total += _panel(lo, hi, k, c, S, T, path, span, nodes, weights)
+        total += nodes.size if count else _panel(lo, hi, k, c, S, T, path, span, nodes,
+                                                 weights)
         hi = lo
     for j in range(DECAY_EDGES.size - 1):
         lo = DECAY_EDGES[j] * relax
         if lo >= end:
             break
-        total += _panel(lo, min(end, DECAY_EDGES[j + 1] * relax), k, c, S, T, path, span,
-                        nodes, weights)
+        total += nodes.size if count else _panel(
+            lo, min(end, DECAY_EDGES[j + 1] * relax), k, c, S, T, path, span, nodes, weights)
     width = T - end
     for j in range(n_graded if width > 0.0 else 0):
         # [T - width r^j, T - width r^(j+1)], the last one reaching T
         lo = T - width * _GRADING ** j
         hi = T - width * _GRADING ** (j + 1) if j < n_graded - 1 else T
-        total += _panel(lo, hi, k, c, S, T, path, span, nodes, weights)
+        total += nodes.size if count else _panel(lo, hi, k, c, S, T, path, span, nodes,
+                                                 weights)
     return total
-
-
-@njit(cache=True)
-def nodes_per_gap(k, c, T, n_graded, n_points):
-    """Gauss nodes of one :func:`memory_integral` at ``T``."""
-    if c == 0.0 or k == 0.0 or T <= 0.0:
-        return 0
-    panels = n_graded
-    for j in range(DECAY_EDGES.size - 1):
-        if DECAY_EDGES[j] * c / k >= T:
-            break
-        panels += 1
-    return panels * n_points
 
 
 @njit(cache=True)
@@ -263,23 +287,21 @@ def secant_root(k, c, H0, path, span, t0, slope, n_graded, nodes, weights):
 
 @njit(cache=True)
 def lobatto_interpolate(u_nodes, values, u, out):
-    """The polynomial through ``values`` at the Chebyshev-Lobatto nodes ``u_nodes`` of
-    ``[0, 1]`` (``(1 - cos(pi j / n)) / 2``, ascending), at each ``u``, written to ``out``
-    (the barycentric formula: stable at every degree)."""
-    n = u_nodes.size - 1
+    """:func:`_barycentric` at each of ``u``, written to ``out``."""
     for i in range(u.size):
-        num = 0.0
-        den = 0.0
-        exact = -1
-        for j in range(n + 1):
-            diff = u[i] - u_nodes[j]
-            if diff == 0.0:
-                exact = j
-                break
-            w = (0.5 if j == 0 or j == n else 1.0) * (1.0 if j % 2 == 0 else -1.0) / diff
-            num += w * values[j]
-            den += w
-        out[i] = values[exact] if exact >= 0 else num / den
+        out[i] = _barycentric(u_nodes, values, u[i])
+
+
+@njit(cache=True)
+def lobatto_spread(u_nodes, values):
+    """The largest difference between ``values`` at the odd nodes and the interpolant through
+    the even ones (half as many nodes, nested): how far that interpolant is from converged,
+    a cautious estimate for the one through all of them."""
+    spread = 0.0
+    coarse_u, coarse_values = u_nodes[::2], values[::2]
+    for j in range(1, u_nodes.size, 2):
+        spread = max(spread, abs(_barycentric(coarse_u, coarse_values, u_nodes[j]) - values[j]))
+    return spread
 
 
 @njit(cache=True)

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 from ..kernels import onset_quadrature as kernels
-from .frozen import frozen_detach_time
+from .frozen import frozen_detach_time, frozen_memory, zone_ratio
 from .problem import Problem
 
 #: Chebyshev-Lobatto intervals of the lift's first and largest collocation.
@@ -92,7 +92,7 @@ def machine_pull(problem: Problem, machine_stiffness: float, t_limit: float,
     span = min(first, t_limit)
     for _ in range(200):
         path, estimate = _path(k, c, kappa, span, max(1e-13, 1e-3 * rtol))
-        t_end = _frozen_onset(k, c, path, span)
+        t_end = _frozen_onset(problem, path, span)
         if t_end is not None and t_end < 0.5 * span:
             # The first span (the rigid pull's) can overshoot a soft spring's onset by orders
             # of magnitude: the path then spends its nodes past the onset (a review found
@@ -141,24 +141,17 @@ def _first_span(problem: Problem, kappa: float) -> float:
     return 1.25 * (t_rigid + float(zone_force(s_rigid)) / kappa)
 
 
-def _frozen_gap(k, c, T, H, S):
-    """The frozen-load gap (every element carrying its current load since ``T = 0``): a lower
-    bound of the exact gap while ``S`` grows (arrays)."""
-    if c == 0.0:
-        memory = np.full_like(T, 1.0 / k)
-    elif k == 0.0:
-        memory = T / c
-    else:
-        memory = -np.expm1(-k * T / c) / k
-    width = S * S / (1.0 + np.sqrt(1.0 + S * S))
-    return (2.0 / math.pi) * (H * np.arctan(S) - memory * width)
+def _frozen_gap(problem: Problem, T, H, S):
+    """The frozen-load gap (every element carrying its current load since ``T = 0``,
+    :mod:`.frozen`) along the path: a lower bound of the exact gap while ``S`` grows."""
+    return (2.0 / math.pi) * (H * np.arctan(S) - frozen_memory(problem, T) * zone_ratio(S))
 
 
-def _frozen_onset(k, c, path, span):
+def _frozen_onset(problem: Problem, path, span):
     """The first time in ``[0, span]`` where the path's frozen gap reaches 1, or None: first
     node above 1, then bisection on the interpolated path."""
     u, H, S = path
-    gaps = _frozen_gap(k, c, span * u * u, H, S)
+    gaps = _frozen_gap(problem, span * u * u, H, S)
     above = np.nonzero(gaps >= 1.0)[0]
     if above.size == 0:
         return None
@@ -171,7 +164,7 @@ def _frozen_onset(k, c, path, span):
         if not lo < mid < hi:
             break
         h, s = (kernels.path_value(path, row, span, mid) for row in (1, 2))
-        g = _frozen_gap(k, c, np.array([mid]), np.array([h]), np.array([s]))[0]
+        g = _frozen_gap(problem, np.array([mid]), np.array([h]), np.array([s]))[0]
         lo, hi = (mid, hi) if g < 1.0 else (lo, mid)
     return hi
 
@@ -200,10 +193,8 @@ def _path(k, c, kappa, span, tol):
         # ODE's discretisation), and its interpolant through every other node against the
         # rest (the path between nodes: an elastic solid's collocation is exact at every
         # node, and the first check alone passed paths 0.6 % off between them).
-        half = np.empty(n // 2)
-        kernels.lobatto_interpolate(u[::2], S[::2], u[1::2], half)
         scale = max(np.max(np.abs(S)), 1e-300)
-        change = float(np.max(np.abs(half - S[1::2]))) / scale
+        change = kernels.lobatto_spread(u, S) / scale
         if previous is not None:
             change = max(change, float(np.max(np.abs(S[::2] - previous[2]))) / scale)
             if change <= tol or n >= _MAX_NODES:
@@ -233,9 +224,7 @@ def _lobatto_differentiation(n: int):
     dx = x[:, None] - x[None, :]
     D = np.outer(weight, 1.0 / weight) / (dx + np.eye(n + 1))
     D -= np.diag(D.sum(axis=1))
-    u = 0.5 * (1.0 - x)
-    u[0], u[-1] = 0.0, 1.0
-    return u, -2.0 * D
+    return kernels.lobatto_nodes(n), -2.0 * D
 
 
 def _collocate(k, c, kappa, T, D, guess):

@@ -65,14 +65,6 @@ def _rule(m: int):
     return graded, 0.5 * (x + 1.0), 0.5 * w
 
 
-@functools.lru_cache(maxsize=None)
-def _lobatto(n: int) -> np.ndarray:
-    """The ``n + 1`` Chebyshev-Lobatto nodes of [0, 1], ascending, 0 and 1 exact."""
-    u = 0.5 * (1.0 - np.cos(np.pi * np.arange(n + 1) / n))
-    u[0], u[-1] = 0.0, 1.0
-    return u
-
-
 def first_rule(rtol: float) -> int:
     """The cheapest rule expected to be :data:`_RULE_MARGIN` within ``rtol`` (the last but
     one at most: the last checks it)."""
@@ -95,16 +87,7 @@ class QuadratureRun:
         self.evaluations = 0
 
     def nodes_per_gap(self, t: float) -> int:
-        graded, nodes, _ = self.rule
-        if not self.lift[0].size or self.c == 0.0:
-            return kernels.nodes_per_gap(self.k, self.c, t, graded, nodes.size)
-        # Behind a spring: also the panels graded toward the pull's start, where the memory
-        # reaches back that far (kernels.memory_integral)
-        relax = self.c / self.k if self.k > 0.0 else math.inf
-        if 0.5 * t >= kernels.DECAYS * relax:
-            return kernels.nodes_per_gap(self.k, self.c, t, graded, nodes.size)
-        return (kernels.nodes_per_gap(self.k, self.c, 0.5 * t, graded, nodes.size)
-                if self.k > 0.0 else graded * nodes.size) + graded * nodes.size
+        return kernels.nodes_per_gap(self.k, self.c, self.H0, *self.lift, t, *self.rule)
 
     def gaps(self, t: np.ndarray) -> np.ndarray:
         self.evaluations += t.size
@@ -174,17 +157,14 @@ def history_interpolant(run: QuadratureRun, span: Span, rtol: float):
     (in ``delta``) at the rest, or :data:`_MAX_NODES`; ``estimate`` is that largest
     difference."""
     n = _FIRST_NODES
-    u = _lobatto(n)
+    u = kernels.lobatto_nodes(n)
     values = run.gaps(span.times(u))
     while True:
-        odd = u[1::2]
-        coarse = np.empty(odd.size)
-        kernels.lobatto_interpolate(u[::2], values[::2], odd, coarse)
-        estimate = float(np.max(np.abs(coarse - values[1::2])))
+        estimate = kernels.lobatto_spread(u, values)
         if estimate <= rtol or n >= _MAX_NODES:
             return u, values, estimate
         n *= 2
-        u_new = _lobatto(n)
+        u_new = kernels.lobatto_nodes(n)
         merged = np.empty(n + 1)
         merged[::2] = values
         merged[1::2] = run.gaps(span.times(u_new[1::2]))
@@ -228,7 +208,6 @@ def _crossing(problem: Problem, m: int, span: Span, bounded: bool, rtol: float):
         # The gap at the start within rounding of 1 where the frozen bound put it below: the
         # onset is there. (A relaxation layer before a later start only lowers the gap.)
         return span.start, 0.0, history, runs
-    t_at = span.times(u[max(j - 2, 0):j + 2])
     lo, hi = span.times(u[j - 1:j + 1])
     t_coarse, slope = coarse.root_in(lo, hi, values[j - 1] - 1.0, values[j] - 1.0)
     last = j == u.size - 1
@@ -236,7 +215,8 @@ def _crossing(problem: Problem, m: int, span: Span, bounded: bool, rtol: float):
     if math.isnan(t_fine):
         # The finer rule's root left the bracket (a root on a node): the widest bracket the
         # history allows.
-        t_fine = fine.root_near(t_coarse, slope, t_at[0], t_at[-1],
+        wide = span.times(u[[max(j - 2, 0), min(j + 1, u.size - 1)]])
+        t_fine = fine.root_near(t_coarse, slope, wide[0], wide[1],
                                 bounded and j + 1 >= u.size - 1)
     if math.isnan(t_fine):
         return t_coarse, math.inf, history, runs
