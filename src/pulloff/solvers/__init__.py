@@ -53,6 +53,16 @@ def simulate(scene, progress=None, stream=None, observers: Observers | None = No
     ``progress`` is a progress hook (see :class:`Observers`) and ``stream`` a callable taking
     SI history columns as a fixed-step run computes them.
     """
-    solver = route(scene)
     observers = observers or Observers.for_scene(scene, progress=progress, stream=stream)
-    return solver.solve(scene, observers)
+    return route(_observed(scene, observers)).solve(scene, observers)
+
+
+def _observed(scene, observers: Observers):
+    """``scene`` with the history and snapshots that ``observers`` ask for (given through
+    the Python API rather than the scene's output section): routing must see them, since
+    not every solver keeps steps or element fields."""
+    every, snapshots = observers.every, list(observers.snapshot_times)
+    if every == scene.output.every and snapshots == list(scene.output.snapshots):
+        return scene
+    return scene.model_copy(update={"output": scene.output.model_copy(
+        update={"every": every, "snapshots": snapshots})})

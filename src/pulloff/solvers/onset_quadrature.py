@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kernels import onset_quadrature as kernels
-from ..model.scene import SceneError
 from .base import Solver, problem as problem_line
 from .frozen import frozen_detach_time
 from .machine_lift import kappa_of, machine_pull, spring_to_solid
@@ -307,10 +306,6 @@ class OnsetQuadratureSolver(Solver):
         return out
 
     def solve(self, scene, observers):
-        if observers.snapshot_times or observers.every is not None:
-            # Observers given through the Python API, not by the scene routing saw: what
-            # they ask for needs the stepper's steps and fields.
-            return self._stepper(scene, observers)
         wall_start = time.perf_counter()
         problem = Problem.from_scene(scene)
         t_limit = (math.inf if scene.numerics.t_max is None
@@ -339,17 +334,3 @@ class OnsetQuadratureSolver(Solver):
         return assemble(scene, problem, run, estimate, math.nan, observers,
                         time.perf_counter() - wall_start, notes, False, solver=self.name,
                         extra=peaks)
-
-    @staticmethod
-    def _stepper(scene, observers):
-        """A stepper for observers that ask for snapshots or every n-th step (the onset
-        stepper, or the contact solver behind a spring); refused (one line each) where the
-        scene rules every stepper out."""
-        from . import SOLVERS  # (the registry imports this module)
-
-        steppers = [solver for solver in SOLVERS if solver.method == "stepper"]
-        for solver in steppers:
-            if not solver.unsupported(scene):
-                return solver.solve(scene, observers)
-        raise SceneError([f"{line} (the observers ask for snapshots or every n-th step, which "
-                          "only a stepper keeps)" for line in steppers[0].unsupported(scene)])
