@@ -251,7 +251,7 @@ def test_ctrl_c_in_the_quadrature_onset_writes_no_file(tmp_path, capsys, monkeyp
     """The quadrature onset takes a fraction of a millisecond and keeps no partial state: a
     Ctrl-C in it ends the run with no result or temporary file left (the lock stays, as after
     every run: see the README)."""
-    from pulloff.kernels import onset_quadrature as quadrature_kernels
+    from pulloff.kernels import quadrature as quadrature_kernels
 
     def interrupt(*args):
         raise KeyboardInterrupt
@@ -270,8 +270,9 @@ def test_cli_run_without_a_plot(tmp_path):
     assert h5io.load(out)["summary"]["detached"]
 
 
-@pytest.mark.parametrize("config,kernel", [("seed_flat_punch", "onset_quadrature.secant_root"),
-                                           ("separation_kv", "contact.evaluate_step"),
+@pytest.mark.parametrize("config,kernel", [("seed_flat_punch", "quadrature.secant_root"),
+                                           ("separation_kv", "quadrature.edge_gap_split"),
+                                           ("sphere_elastic", "contact.evaluate_step"),
                                            ("frozen_history", None)])
 def test_the_compile_notice_follows_the_kernels_the_scene_needs(config, kernel, tmp_path,
                                                                  monkeypatch, capsys):
@@ -312,5 +313,5 @@ def test_numba_is_asked_whether_a_solvers_kernel_is_cached():
     from pulloff.kernels import cache_is_warm, cached_entries
 
     simulate(load_scene(SEED))
-    assert cached_entries("onset_quadrature.secant_root") >= 1
-    assert cache_is_warm("onset_quadrature.secant_root")
+    assert cached_entries("quadrature.secant_root") >= 1
+    assert cache_is_warm("quadrature.secant_root")

@@ -124,7 +124,7 @@ def test_three_levels_converging_at_up_to_fourth_order_stop_with_an_honest_estim
                         lambda scene, n, *a: levels.append(n) or run_level(scene, n, *a))
     scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
                        overrides=["loading.v=1e-4", "model.until=separation",
-                                  "numerics.rtol=1e-3"])
+                                  "numerics.rtol=1e-3", "numerics.method=stepper"])
     res = solvers.simulate(scene)
     ref = REFERENCE["sls_finite_punch_v1e-4"]
     error = max(abs(getattr(res, ours) / ref[theirs] - 1.0) for ours, theirs in (

@@ -10,7 +10,7 @@ from hypothesis import given, settings, strategies as st
 from scipy import integrate, special
 
 from pulloff.io.scene_file import load_scene, scene_from_groups
-from pulloff.kernels import onset_quadrature as kernels
+from pulloff.kernels import quadrature as kernels
 from pulloff.model.scene import SceneError
 from pulloff.solvers import route, simulate
 from pulloff.solvers import onset_quadrature as quadrature
@@ -212,7 +212,8 @@ def test_the_stepper_runs_what_needs_steps(overrides, solver):
      "output.snapshots"),
     ("seed_flat_punch", ["numerics.method=quadrature", "output.every=2"], "output.every"),
     ("seed_flat_punch", ["numerics.method=stepper", "numerics.rtol=1e-11"], "numerics.rtol"),
-    ("separation_kv", ["numerics.method=quadrature"], "model.until"),
+    ("separation_kv", ["numerics.method=quadrature", "loading.machine_stiffness=100"],
+     "loading.machine_stiffness"),
     ("separation_kv", ["numerics.rtol=1e-11"], "numerics.rtol"),
     ("frozen_history", ["numerics.method=stepper"], "numerics.method"),
 ])

@@ -14,7 +14,9 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+import numpy as np
 from pydantic import Field, model_validator
+from scipy.optimize import brentq
 
 from .fields import Num, bad_line
 from .registry import Kind, Registry
@@ -51,10 +53,37 @@ class Spectrum:
             return (self.eta / self.G_inf,)
         return ()
 
+    def creep(self) -> tuple:
+        """The shear creep compliance ``J(t) = J(0) + int_0^t J'`` (``J * G = t``), as
+        ``(J(0) [1/Pa], rates [1/s], weights [1/(Pa s)])`` with ``J'(t) = sum_k weights_k
+        exp(-rates_k t)``. Its rates are the roots of ``s G^(s) = 0`` on the negative axis, one
+        between each two arms' rates, one below the slowest (``G_inf > 0``), one above the
+        fastest behind a damper; a viscous solid (``G_inf = 0``) creeps at the rate 0."""
+        if not self.arms:
+            if self.eta == 0.0:
+                return 1.0 / self.G_inf, np.zeros(0), np.zeros(0)
+            return 0.0, np.array([self.G_inf / self.eta]), np.array([1.0 / self.eta])
+        G = np.array([g for g, _ in self.arms])
+        mu = np.array([1.0 / tau for _, tau in self.arms])
+        G, mu = G[np.argsort(mu)], np.sort(mu)
+
+        def s_modulus(lam):  # s G^(s) at s = -lam, between the poles -mu_i
+            return self.G_inf - float(np.sum(G * lam / (mu - lam)))
+
+        rates = []
+        below = 0.0
+        for m in mu:
+            # s G^(s) runs from +inf (or G_inf at 0) down to -inf between two poles
+            gap = 1e-14 * m
+            rates.append(brentq(s_modulus, below + (gap if below else 0.0), m - gap,
+                                xtol=1e-300, rtol=4.0 * np.finfo(float).eps))
+            below = m
+        rates = np.array(rates)
+        slope = np.array([np.sum(G * mu / (mu - lam) ** 2) for lam in rates])
+        return 1.0 / self.instantaneous_modulus, rates, 1.0 / slope
+
     def modulus(self, t):
         """``G(t)`` [Pa] for ``t > 0`` (the damper's delta excluded)."""
-        import numpy as np
-
         t = np.asarray(t, dtype=float)
         return self.G_inf + sum(G * np.exp(-t / tau) for G, tau in self.arms)
 

@@ -12,15 +12,16 @@ from __future__ import annotations
 from ..model.scene import SceneError
 from .base import Solver
 from .contact import ContactSolver
+from .edge_quadrature import EdgeQuadratureSolver
 from .frozen import FrozenSolver
 from .observers import Observers
 from .onset import OnsetSolver
 from .onset_quadrature import OnsetQuadratureSolver
 
 #: In order of preference: the specialised closed form, the onset by quadrature and the onset
-#: stepper before the general one.
+#: stepper, a rigid pull to separation by quadrature, before the general one.
 SOLVERS: tuple[Solver, ...] = (FrozenSolver(), OnsetQuadratureSolver(), OnsetSolver(),
-                               ContactSolver())
+                               EdgeQuadratureSolver(), ContactSolver())
 
 
 def route(scene) -> Solver:

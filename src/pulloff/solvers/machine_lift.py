@@ -22,7 +22,7 @@ import functools
 import math
 
 import numpy as np
-from ..kernels import onset_quadrature as kernels
+from ..kernels import quadrature as kernels
 from .frozen import frozen_detach_time, frozen_memory, zone_ratio
 from .problem import Problem
 
@@ -37,7 +37,7 @@ def zone_force(S):
 
 
 def zone_of_force(y):
-    """``Phi^-1(y)`` (:func:`pulloff.kernels.onset_quadrature.zone_of_force`; ``Phi`` is odd,
+    """``Phi^-1(y)`` (:func:`pulloff.kernels.quadrature.zone_of_force`; ``Phi`` is odd,
     so a compressed spring's ``y < 0`` gives ``-Phi^-1(-y)``: Newton's trial lifts may ask
     for it, and a clipped inverse there stalled Newton on a stiff spring)."""
     y = np.asarray(y, dtype=float)

@@ -1,5 +1,5 @@
 """The seed's onset by quadrature: the gap as one integral over the load history
-(:mod:`pulloff.kernels.onset_quadrature`), its root, and the history as an interpolant.
+(:mod:`pulloff.kernels.quadrature`), its root, and the history as an interpolant.
 
 Each Gauss rule of :data:`_RULES` integrates the gap to a known accuracy (measured on the
 work-precision scenes and the hard cases against the reference: the errors of
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kernels import onset_quadrature as kernels
+from ..kernels import quadrature as kernels
 from .base import Solver, problem as problem_line
 from .frozen import frozen_detach_time
 from .machine_lift import kappa_of, machine_pull, spring_to_solid
@@ -273,7 +273,7 @@ class OnsetQuadratureSolver(Solver):
 
     name = "onset_quadrature"
     method = "quadrature"
-    kernel = "onset_quadrature.secant_root"  # compiled last
+    kernel = "quadrature.secant_root"  # compiled last
     summary = ("seed onset by quadrature over the load history (flat punch, external zone, "
                "Kelvin-Voigt, rigid or through a machine spring; no steps)")
 

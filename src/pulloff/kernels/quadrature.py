@@ -1,0 +1,860 @@
+"""Numba kernels of the quadratures: the exact gap of a flat punch as one integral over its
+load history, with the zone's part in closed form (Carlson's elliptic integrals).
+
+**The seed's onset** (the first part of this module). Dimensionless as
+:mod:`pulloff.kernels.onset` (lengths in ``a``, displacements in ``delta``, time in
+``delta / v``; ``S(T) = k (H0 + T) + c``). An element at ``sigma`` entered the zone when ``S``
+passed it (or at ``T = 0``) and carries
+``U = (1/c) int exp(-k (T - T')/c) sqrt(S(T')^2 - sigma^2) dT'``. Swapping the order of the
+gap's two integrals (over elements, then over their load history) gives
+
+    gap = (2/pi) [ H atan(S) - I ],
+    I(T) = (1/c) int_0^T exp(-k tau / c) K(S(T - tau)^2, S(T)^2) dtau,
+    K(P, Q) = 1/2 int_0^P sqrt(P - w) / sqrt((1 + w)(Q - w)) dw   (w = sigma^2),
+
+and ``K`` is an elliptic integral: Carlson's ``R_D`` in closed form (:func:`zone_kernel`). What
+is left is a one-dimensional integral in ``tau``, smooth but for a ``tau log tau`` term at
+``tau = 0`` (``K`` has ``d log d`` at ``d = Q - P -> 0``), which Gauss rules on panels graded
+geometrically toward ``tau = 0`` integrate to full precision with a few dozen nodes. The
+stepper (:mod:`pulloff.kernels.onset`) marches every element of the zone instead; both
+methods solve the same model, and the reference (:mod:`pulloff.references.onset`) integrates
+over the elements first, adaptively.
+
+**A moving edge** (the second part, :func:`edge_gap`): the same swap for a flat punch whose
+bond radius ``a`` and zone end ``b`` both move, under any rheology with a creep compliance
+``J(t) = J(0) + int J'`` of exponentials. See :mod:`pulloff.solvers.edge_quadrature`.
+
+Kernels that call each other live in this one module (numba's disk cache does not track
+cross-module changes).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+#: The memory kernel is cut where ``exp(-k tau / c)`` falls below ``exp(-DECAYS)``: e^-40
+#: ~ 4e-18 of an integrand that is largest at ``tau = 0``.
+DECAYS = 40.0
+#: Edges, in relaxation times ``c / k``, of the panels past the first relaxation time: each
+#: short enough for a Gauss rule of the level's order on ``exp(-y)`` (the error of ``n``
+#: points on a panel of length ``L`` is ~``(L/2)^(2n) / (2n)!`` of its weight).
+DECAY_EDGES = np.array([1.0, 2.0, 4.0, 8.0, 13.0, 19.0, 26.0, 33.0, DECAYS])
+#: Ratio of consecutive panels graded toward ``tau = 0``.
+_GRADING = 0.25
+
+
+@njit(cache=True)
+def carlson_rd(x, y, z):
+    """Carlson's ``R_D(x, y, z) = 3/2 int_0^inf dt / (sqrt((t+x)(t+y)) (t+z)^(3/2))`` for
+    ``x, y >= 0`` (at most one zero) and ``z > 0``, to ~1e-16 relative: duplication until the
+    arguments agree to the series' order, then its seventh-order expansion (B. C. Carlson,
+    Numer. Algorithms 10 (1995) 13-26; DLMF 19.36.2)."""
+    a0 = (x + y + 3.0 * z) / 5.0
+    a = a0
+    # (r/4)^(-1/6) = 575 for r = 2^-53: the series' error then stays below the rounding.
+    q = 6.0e2 * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
+    total = 0.0
+    scale = 1.0
+    while scale * q >= abs(a):
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+        lam = sx * sy + sx * sz + sy * sz
+        total += scale / (sz * (z + lam))
+        scale *= 0.25
+        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
+    X = (a - x) / a
+    Y = (a - y) / a
+    Z = -(X + Y) / 3.0
+    xy, zz = X * Y, Z * Z
+    e2 = xy - 6.0 * zz
+    e3 = (3.0 * xy - 8.0 * zz) * Z
+    e4 = 3.0 * (xy - zz) * zz
+    e5 = xy * zz * Z
+    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
+    return scale * series / (a * math.sqrt(a)) + 3.0 * total
+
+
+@njit(cache=True)
+def zone_kernel(P, d):
+    """``K(P, P + d) = 1/2 int_0^P sqrt(P - w) / sqrt((1 + w)(P + d - w)) dw`` for
+    ``P, d >= 0``: the zone's weight of a load ``S'^2 = P`` seen by the gap at ``S^2 = P + d``.
+
+    With ``w = P - P / (t + 1)`` the integral is ``P^(3/2) R_D(1/(1+P), (P+d)/d, 1) /
+    (3 sqrt((1+P) d))``; at ``d = 0`` it is ``sqrt(1 + P) - 1``, the frozen zone's width."""
+    if d <= 0.0:
+        return P / (1.0 + math.sqrt(1.0 + P))
+    if P <= 0.0:
+        return 0.0
+    return P * math.sqrt(P) * carlson_rd(1.0 / (1.0 + P), (P + d) / d, 1.0) / (
+        3.0 * math.sqrt((1.0 + P) * d))
+
+
+def lobatto_nodes(n: int) -> np.ndarray:
+    """The ``n + 1`` Chebyshev-Lobatto nodes of [0, 1], ``(1 - cos(pi j / n)) / 2``, ascending,
+    0 and 1 exact: the nodes of every interpolant here (plain Python, kept per ``n``)."""
+    if n not in _LOBATTO:
+        u = 0.5 * (1.0 - np.cos(np.pi * np.arange(n + 1) / n))
+        u[0], u[-1] = 0.0, 1.0
+        _LOBATTO[n] = u
+    return _LOBATTO[n]
+
+
+_LOBATTO: dict = {}
+
+
+@njit(cache=True)
+def _barycentric(u_nodes, values, u):
+    """The polynomial through ``values`` at the Chebyshev-Lobatto nodes ``u_nodes`` of
+    [0, 1] (:func:`lobatto_nodes`), at ``u``: the barycentric formula, stable at every
+    degree."""
+    n = u_nodes.size - 1
+    num = 0.0
+    den = 0.0
+    for j in range(n + 1):
+        diff = u - u_nodes[j]
+        if diff == 0.0:
+            return values[j]
+        w = (0.5 if j == 0 or j == n else 1.0) * (1.0 if j % 2 == 0 else -1.0) / diff
+        num += w * values[j]
+        den += w
+    return num / den
+
+
+@njit(cache=True)
+def path_value(path, row, span, T):
+    """Row ``row`` (1: the lift ``H``, 2: ``S``) of a lift path at ``T``: the polynomial
+    through ``path[row]`` at the Chebyshev-Lobatto nodes ``path[0]`` of ``sqrt(T / span)``
+    in [0, 1] (the lift's start is smooth in the square root)."""
+    return _barycentric(path[0], path[row], math.sqrt(max(T, 0.0) / span))
+
+
+@njit(cache=True)
+def lift_and_zone(k, c, H0, path, span, T):
+    """``(H, S)`` at ``T``: the rigid pull's ``H0 + T`` and ``k H + c``, or a lift path's
+    (``path`` of shape ``(3, n + 1)``: nodes, ``H``, ``S``; shape ``(3, 0)``: rigid)."""
+    if path.shape[1] == 0:
+        return H0 + T, k * (H0 + T) + c
+    return path_value(path, 1, span, T), path_value(path, 2, span, T)
+
+
+@njit(cache=True)
+def _panel(lo, hi, k, c, S, T, path, span, nodes, weights):
+    """``(1/c) int_lo^hi exp(-k tau/c) K(S(T - tau)^2, S^2) dtau`` by the Gauss rule
+    ``nodes, weights`` on [0, 1]; ``S(T - tau) = S - k tau`` on a rigid pull, else the
+    path's (never above ``S``: the zone only grows before the onset)."""
+    width = hi - lo
+    total = 0.0
+    rigid = path.shape[1] == 0
+    for i in range(nodes.size):
+        tau = lo + width * nodes[i]
+        if rigid:
+            k_tau = k * tau
+            s_then = S - k_tau
+            d = k_tau * (S + s_then)
+        else:
+            s_then = min(path_value(path, 2, span, T - tau), S)
+            d = (S - s_then) * (S + s_then)
+        total += weights[i] * math.exp(-k * tau / c) * zone_kernel(s_then * s_then, d)
+    return total * width / c
+
+
+@njit(cache=True)
+def memory_integral(k, c, H0, path, span, T, n_graded, nodes, weights):
+    """``I(T)`` of the module docstring (:func:`_over_panels`); ``path``, ``span``: the lift
+    (:func:`lift_and_zone`)."""
+    S = lift_and_zone(k, c, H0, path, span, T)[1]
+    if c == 0.0:  # elastic: every element carries its current load, at t = 0 too
+        return zone_kernel(S * S, 0.0) / k
+    if T <= 0.0:  # a damper cannot move at once (MODEL.md, settled questions)
+        return 0.0
+    if k == 0.0 and path.shape[1] == 0:  # viscous, rigid: S is constant, the load too
+        return T / c * zone_kernel(S * S, 0.0)
+    return _over_panels(k, c, S, T, path, span, n_graded, nodes, weights, False)
+
+
+@njit(cache=True)
+def nodes_per_gap(k, c, H0, path, span, T, n_graded, nodes, weights):
+    """Gauss nodes of one :func:`memory_integral` at ``T`` (none for its closed forms)."""
+    if c == 0.0 or T <= 0.0 or (k == 0.0 and path.shape[1] == 0):
+        return 0
+    return int(_over_panels(k, c, 0.0, T, path, span, n_graded, nodes, weights, True))
+
+
+@njit(cache=True)
+def _over_panels(k, c, S, T, path, span, n_graded, nodes, weights, count):
+    """The sum of :func:`_panel` over the layout (or, with ``count``, its number of nodes):
+    ``n_graded`` panels graded toward ``tau = 0`` over the first relaxation time ``c / k``
+    (or all of ``[0, T]`` if shorter), then panels ending at ``DECAY_EDGES`` relaxation
+    times, cut at ``T``; behind a lift path whose memory reaches back to the pull's start,
+    the first half only, and ``n_graded`` panels graded toward ``tau = T`` on the rest."""
+    relax = c / k if k > 0.0 else math.inf
+    # A lift path starts with the punch catching up with the driver: a layer at tau = T.
+    end = T
+    if path.shape[1] > 0 and 0.5 * T < DECAYS * relax:
+        end = 0.5 * T
+    hi = min(end, relax)
+    total = 0.0
+    for j in range(n_graded):
+        lo = hi * _GRADING if j < n_graded - 1 else 0.0
+        total += nodes.size if count else _panel(lo, hi, k, c, S, T, path, span, nodes,
+                                                 weights)
+        hi = lo
+    for j in range(DECAY_EDGES.size - 1):
+        lo = DECAY_EDGES[j] * relax
+        if lo >= end:
+            break
+        total += nodes.size if count else _panel(
+            lo, min(end, DECAY_EDGES[j + 1] * relax), k, c, S, T, path, span, nodes, weights)
+    width = T - end
+    for j in range(n_graded if width > 0.0 else 0):
+        # [T - width r^j, T - width r^(j+1)], the last one reaching T
+        lo = T - width * _GRADING ** j
+        hi = T - width * _GRADING ** (j + 1) if j < n_graded - 1 else T
+        total += nodes.size if count else _panel(lo, hi, k, c, S, T, path, span, nodes,
+                                                 weights)
+    return total
+
+
+@njit(cache=True)
+def gap(k, c, H0, path, span, T, n_graded, nodes, weights):
+    """The gap at the end of the zone at ``T``, in ``delta``."""
+    H, S = lift_and_zone(k, c, H0, path, span, T)
+    return (2.0 / math.pi) * (H * math.atan(S) - memory_integral(k, c, H0, path, span, T,
+                                                                 n_graded, nodes, weights))
+
+
+@njit(cache=True)
+def gaps(k, c, H0, path, span, times, n_graded, nodes, weights):
+    """:func:`gap` at each of ``times``."""
+    out = np.empty(times.size)
+    for i in range(times.size):
+        out[i] = gap(k, c, H0, path, span, times[i], n_graded, nodes, weights)
+    return out
+
+
+@njit(cache=True)
+def detach_time(k, c, H0, path, span, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
+    """The root of ``gap = 1`` in ``[lo, hi]``, where ``g_lo = gap(lo) - 1 < 0 <= g_hi =
+    gap(hi) - 1``, by the Illinois variant of regula falsi, to rounding: ``(T, slope,
+    evaluations)`` with ``slope`` the last secant's ``d gap / dT``."""
+    n_eval = 0
+    side = 0
+    last = hi
+    for _ in range(100):
+        if g_hi == 0.0 or hi - lo <= 4.0 * 2.2e-16 * hi:
+            break
+        mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        if not lo < mid < hi:
+            mid = 0.5 * (lo + hi)
+        if abs(mid - last) <= 2.2e-16 * mid:
+            break  # the iterates stand still: rounding decides the last digit
+        last = mid
+        g_mid = gap(k, c, H0, path, span, mid, n_graded, nodes, weights) - 1.0
+        n_eval += 1
+        if g_mid < 0.0:
+            lo, g_lo = mid, g_mid
+            if side == -1:
+                g_hi *= 0.5
+            side = -1
+        else:
+            hi, g_hi = mid, g_mid
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+    slope = (g_hi - g_lo) / (hi - lo) if hi > lo else 0.0
+    root = hi if g_hi == 0.0 or -g_lo > g_hi else lo
+    return root, slope, n_eval
+
+
+@njit(cache=True)
+def secant_root(k, c, H0, path, span, t0, slope, n_graded, nodes, weights):
+    """The root of ``gap = 1`` near ``t0`` by secants from ``t0`` with the first slope
+    ``slope`` (a root of a nearby rule): ``(T, evaluations)``; ``T`` is nan where the
+    iterates do not settle within 12 evaluations (the caller then brackets)."""
+    g0 = gap(k, c, H0, path, span, t0, n_graded, nodes, weights) - 1.0
+    n_eval = 1
+    for _ in range(11):
+        if g0 == 0.0 or not slope != 0.0:
+            return t0, n_eval
+        t1 = t0 - g0 / slope
+        if abs(t1 - t0) <= 2.2e-16 * abs(t1):
+            return t1, n_eval
+        g1 = gap(k, c, H0, path, span, t1, n_graded, nodes, weights) - 1.0
+        n_eval += 1
+        if g1 != g0:
+            slope = (g1 - g0) / (t1 - t0)
+        t0, g0 = t1, g1
+    return math.nan, n_eval
+
+
+@njit(cache=True)
+def lobatto_interpolate(u_nodes, values, u, out):
+    """:func:`_barycentric` at each of ``u``, written to ``out``."""
+    for i in range(u.size):
+        out[i] = _barycentric(u_nodes, values, u[i])
+
+
+@njit(cache=True)
+def lobatto_spread(u_nodes, values):
+    """The largest difference between ``values`` at the odd nodes and the interpolant through
+    the even ones (half as many nodes, nested): how far that interpolant is from converged,
+    a cautious estimate for the one through all of them."""
+    spread = 0.0
+    coarse_u, coarse_values = u_nodes[::2], values[::2]
+    for j in range(1, u_nodes.size, 2):
+        spread = max(spread, abs(_barycentric(coarse_u, coarse_values, u_nodes[j]) - values[j]))
+    return spread
+
+
+@njit(cache=True)
+def zone_of_force(y, out):
+    """``S = Phi^-1(y)`` for each of ``y``, ``Phi(S) = S + (1 + S^2) atan(S)`` (odd, convex
+    for ``S >= 0``): Newton from above, written to ``out``. The lift behind a machine spring
+    inverts it ~100 times a run (:mod:`pulloff.solvers.machine_lift`)."""
+    for i in range(y.size):
+        target = abs(y[i])
+        # Phi(S) >= 2 S and >= (pi/2) S^2: the smaller inverse bounds S from above.
+        S = min(0.5 * target, math.sqrt(2.0 * target / math.pi))
+        for _ in range(60):
+            atan = math.atan(S)
+            step = (S + (1.0 + S * S) * atan - target) / (2.0 + 2.0 * S * atan)
+            S -= step
+            if abs(step) <= 4e-16 * S or S <= 0.0:
+                break
+        S = max(S, 0.0)
+        out[i] = S if y[i] >= 0.0 else -S
+
+
+# --------------------------------------------------------------------------------------------
+# A moving edge. Units: lengths in the punch radius R, line loads in 2 sigma_c R, compliances
+# in pi delta / (sigma_c R) (so the gap comes out in delta), time in the solver's scale.
+# Whatever the rheology, an element's opening against a bonded one, d = u_bonded - u, is
+# (1/4) int J(T - s) dg(s) with g = L - f >= 0 the load it lacks (f = L while bonded), so
+#     gap(b_T) = (2/pi) int_0^b_T d(x, T) / sqrt(b_T^2 - x^2) dx
+#              = J(0) opening(T, T) + int J'(T - s) opening(s, T) ds,
+#     opening(s, T) = int_0^b_T g(x, s) / sqrt(b_T^2 - x^2) dx
+# is elementary plus one elliptic integral (zone_weight). No h, so no cancellation when the
+# lift is many delta. A state is (ell, r, P): the bonded load ell = L / (2 sigma_c R),
+# r = 1 - a^2 (1 once the bond is gone) and P = b^2 - a^2.
+# The history after the onset is held as nodes hist[0] = t, hist[1] = p (r while bonded, b^2
+# once the zone is alone), hist[2] = sigma (the march's parameter, in which both t and p are
+# smooth, also at a fold); segs[i] = (first node, phase 2 or 3) of its smooth pieces, each
+# piece's last node repeated as the next one's first. The onset's phase (a or b pinned) is
+# explicit. ctx = [t_onset, zone (0 external, 1 internal), T, ell_T, r_T, P_T].
+# --------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def carlson_rf(x, y, z):
+    a0 = (x + y + z) / 3.0
+    a = a0
+    x0, y0 = x, y
+    q = 3.0e3 * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
+    scale = 1.0
+    while scale * q >= abs(a):
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+        lam = sx * sy + sx * sz + sy * sz
+        scale *= 0.25
+        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
+    X = (a0 - x0) * scale / a
+    Y = (a0 - y0) * scale / a
+    Z = -(X + Y)
+    e2 = X * Y - Z * Z
+    e3 = X * Y * Z
+    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
+
+
+@njit(cache=True)
+def _zone_weight_below(p, d, A):
+    return p * math.sqrt(p) * carlson_rd(A / (A + p), (p + d) / d, 1.0) / (
+        3.0 * math.sqrt((A + p) * d))
+
+
+@njit(cache=True)
+def zone_weight(P, d, A):
+    """1/2 int_0^min(P, P+d) sqrt(P-w)/sqrt((A+w)(P+d-w)) dw."""
+    if P <= 0.0:
+        return 0.0
+    Q = P + d
+    if Q <= 0.0:
+        return 0.0
+    if abs(d) <= 1e-17 * P:  # (the d log d correction is below the rounding)
+        return P / (math.sqrt(A + P) + math.sqrt(A))
+    if d > 0.0:
+        return _zone_weight_below(P, d, A)
+    e = -d
+    j0 = 2.0 * math.sqrt(Q) * carlson_rf(A * e, P * (A + Q), (A + Q) * e)
+    return _zone_weight_below(Q, e, A) + 0.5 * e * j0
+
+
+@njit(cache=True)
+def ell_of(s, rh):
+    """rh = [c0, cv, g_inf, eta, (g_i, tau_i)...]"""
+    c0, cv, g_inf, eta = rh[0], rh[1], rh[2], rh[3]
+    G = g_inf
+    Gam = g_inf * s + eta
+    for i in range(4, rh.size, 2):
+        e = math.exp(-s / rh[i + 1])
+        G += rh[i] * e
+        Gam += rh[i] * rh[i + 1] * (-math.expm1(-s / rh[i + 1]))
+    return c0 * G + cv * Gam
+
+
+@njit(cache=True)
+def creep_rate(tau, cr):
+    """cr = [J0, I_imp, (lam, w)...]"""
+    tot = 0.0
+    for i in range(2, cr.size, 2):
+        tot += cr[i + 1] * math.exp(-cr[i] * tau)
+    return tot
+
+
+@njit(cache=True)
+def lagrange(xs, ys, i0, n, x):
+    tot = 0.0
+    for j in range(i0, i0 + n):
+        num = 1.0
+        den = 1.0
+        xj = xs[j]
+        for m in range(i0, i0 + n):
+            if m != j:
+                num *= x - xs[m]
+                den *= xj - xs[m]
+        tot += ys[j] * num / den
+    return tot
+
+
+@njit(cache=True)
+def opening(ell_s, r_s, P_s, ell_T, r_T, P_T):
+    """int_0^{b_T} g(x, s) / sqrt(b_T^2 - x^2) dx with g = ell_s - sqrt(b_s^2 - x^2)_+ on
+    x > a_s (0 inside): the opening's load against a bonded element."""
+    if P_T == 0.0 and r_T == 1.0:
+        if r_s == 1.0:
+            return 0.5 * math.pi * (ell_s - math.sqrt(P_s))
+        return 0.0
+    Q = P_T + r_s - r_T
+    if Q <= 0.0:
+        return 0.0
+    A = 1.0 - r_s
+    theta = math.atan2(math.sqrt(Q), math.sqrt(A))
+    if r_s == r_T and r_s != 1.0:
+        d = (ell_T - ell_s) * (ell_T + ell_s)
+    else:
+        d = Q - P_s
+    return ell_s * theta - zone_weight(P_s, d, A)
+
+
+@njit(cache=True)
+def opening_now(ell_T, r_T, P_T):
+    if P_T == 0.0 and r_T == 1.0:
+        return 0.5 * math.pi * ell_T
+    A = 1.0 - r_T
+    theta = math.atan2(math.sqrt(P_T), math.sqrt(A))
+    return ell_T * theta - P_T / (math.sqrt(A + P_T) + math.sqrt(A))
+
+
+@njit(cache=True)
+def _stencil(k, n, segs, deg):
+    """(first node, count, phase) of the interpolant on the history's interval k."""
+    i = segs.shape[0] - 1
+    while segs[i, 0] > k:
+        i -= 1
+    lo = segs[i, 0]
+    hi = segs[i + 1, 0] - 1 if i + 1 < segs.shape[0] and segs[i + 1, 0] < n else n - 1
+    m = deg + 1
+    if hi - lo + 1 <= m:
+        return lo, hi - lo + 1, segs[i, 1]
+    return min(max(k - (m // 2 - 1), lo), hi - m + 1), m, segs[i, 1]
+
+
+@njit(cache=True)
+def _basis(xs, i0, m, x, w, dw):
+    """Lagrange basis at x over xs[i0:i0+m] and its derivative, into w, dw (the products of
+    ``x - x_l`` and their derivative accumulated together: no division but the m weights)."""
+    for j in range(m):
+        xj = xs[i0 + j]
+        val = 1.0
+        der = 0.0
+        den = 1.0
+        for l in range(m):
+            if l != j:
+                d = x - xs[i0 + l]
+                der = der * d + val
+                val *= d
+                den *= xj - xs[i0 + l]
+        w[j] = val / den
+        dw[j] = der / den
+
+
+@njit(cache=True)
+def _at_sigma(x, hist, i0, m, w, dw):
+    """(t, dt/dsigma, p) of the interpolant at sigma = x."""
+    _basis(hist[2], i0, m, x, w, dw)
+    t = 0.0
+    dt = 0.0
+    p = 0.0
+    for j in range(m):
+        t += w[j] * hist[0, i0 + j]
+        dt += dw[j] * hist[0, i0 + j]
+        p += w[j] * hist[1, i0 + j]
+    return t, dt, p
+
+
+@njit(cache=True)
+def _sigma_of(s, k, hist, i0, m, w, dw):
+    """The sigma in [sigma_k, sigma_k+1] where t(sigma) = s (safeguarded Newton)."""
+    a, b = hist[2, k], hist[2, k + 1]
+    ta, tb = hist[0, k], hist[0, k + 1]
+    if s <= ta:
+        return a
+    if s >= tb:
+        return b
+    x = a + (b - a) * (s - ta) / (tb - ta)
+    for _ in range(60):
+        t, dt, _p = _at_sigma(x, hist, i0, m, w, dw)
+        f = t - s
+        if f > 0.0:
+            b = x
+        else:
+            a = x
+        xn = x - f / dt if dt > 0.0 else 0.5 * (a + b)
+        if not a <= xn <= b:
+            xn = 0.5 * (a + b)
+        if abs(xn - x) <= 4e-16 * max(abs(x), 1.0):
+            return xn
+        x = xn
+    return x
+
+
+@njit(cache=True)
+def _node_state(j, phase, hist, rh):
+    t = hist[0, j]
+    ell = ell_of(t, rh)
+    if phase == 2:
+        return ell, hist[1, j], ell * ell
+    return ell, 1.0, hist[1, j]
+
+
+@njit(cache=True)
+def _state_sigma(x, phase, hist, i0, m, w, dw, rh):
+    """(s, ds/dsigma, ell, r, P) at sigma = x."""
+    t, dt, p = _at_sigma(x, hist, i0, m, w, dw)
+    ell = ell_of(t, rh)
+    if phase == 2:
+        return t, dt, ell, p, ell * ell
+    return t, dt, ell, 1.0, p
+
+
+@njit(cache=True)
+def _crossing_value(which, ell, r, P, ctx):
+    Q = ctx[5] + r - ctx[4]  # b_T^2 - a_s^2
+    if which == 0:
+        return Q
+    return Q - P  # b_T^2 - b_s^2
+
+
+@njit(cache=True)
+def _crossing_at_edge(s, k, which, ctx, rh, hist, n, segs, deg, w, dw):
+    """the crossing function at an edge s of a panel on interval k (-1: before the onset)."""
+    if k < 0:
+        ell = ell_of(s, rh)
+        if int(ctx[1]) == 0:
+            return _crossing_value(which, ell, 0.0, ell * ell, ctx)
+        return _crossing_value(which, ell, ell * ell, ell * ell, ctx)
+    i0, m, phase = _stencil(k, n, segs, deg)
+    if s == hist[0, k]:
+        ell, r, P = _node_state(k, phase, hist, rh)
+    elif s == hist[0, k + 1]:
+        ell, r, P = _node_state(k + 1, phase, hist, rh)
+    else:
+        x = _sigma_of(s, k, hist, i0, m, w, dw)
+        _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+    return _crossing_value(which, ell, r, P, ctx)
+
+
+@njit(cache=True)
+def _crossing_time(lo, hi, flo, fhi, k, which, ctx, rh, hist, n, segs, deg, w, dw):
+    """The s in (lo, hi) where the crossing function changes sign (Illinois; in sigma on a
+    history interval)."""
+    if k >= 0:
+        i0, m, phase = _stencil(k, n, segs, deg)
+        lo = _sigma_of(lo, k, hist, i0, m, w, dw)
+        hi = _sigma_of(hi, k, hist, i0, m, w, dw)
+    side = 0
+    x = hi
+    for _ in range(100):
+        if hi - lo <= 4e-16 * max(abs(hi), 1e-300):
+            break
+        x = hi - fhi * (hi - lo) / (fhi - flo)
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+        if k < 0:
+            ell = ell_of(x, rh)
+            r = 0.0 if int(ctx[1]) == 0 else ell * ell
+            fx = _crossing_value(which, ell, r, ell * ell, ctx)
+        else:
+            _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+            fx = _crossing_value(which, ell, r, P, ctx)
+        if fx == 0.0:
+            break
+        if (fx < 0.0) == (flo < 0.0):
+            lo, flo = x, fx
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi = x, fx
+            if side == 1:
+                flo *= 0.5
+            side = 1
+    if k < 0:
+        return x
+    return _at_sigma(x, hist, i0, m, w, dw)[0]
+
+
+@njit(cache=True)
+def _history_panel(lo, hi, k, sq_lo, sq_hi, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw):
+    """Gauss over [lo, hi] (in s before the onset, in sigma on history interval k) of
+    J'(T - s) opening(s, T) ds; a u^2 substitution at a square-root end."""
+    zone, T, ell_T, r_T, P_T = int(ctx[1]), ctx[2], ctx[3], ctx[4], ctx[5]
+    if k >= 0:
+        i0, m, phase = _stencil(k, n, segs, deg)
+        a = _sigma_of(lo, k, hist, i0, m, w, dw)
+        b = _sigma_of(hi, k, hist, i0, m, w, dw)
+    else:
+        a, b = lo, hi
+    width = b - a
+    tot = 0.0
+    for i in range(gx.size):
+        u = gx[i]
+        if sq_lo:
+            x = a + width * u * u
+            wgt = gw[i] * 2.0 * u
+        elif sq_hi:
+            x = b - width * u * u
+            wgt = gw[i] * 2.0 * u
+        else:
+            x = a + width * u
+            wgt = gw[i]
+        if k >= 0:
+            s, ds, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+            wgt *= ds
+        else:
+            s = x
+            ell = ell_of(s, rh)
+            r = 0.0 if zone == 0 else ell * ell
+            P = ell * ell
+        tot += wgt * creep_rate(T - s, cr) * opening(ell, r, P, ell_T, r_T, P_T)
+    return tot * width
+
+
+@njit(cache=True)
+def _graded_toward(lo, hi, k, c, toward_hi, m_graded, sq_end, ctx, rh, cr, hist, n, segs, deg, gx,
+            gw, w, dw):
+    """[lo, hi] in panels graded (ratio 1/4 in the distance) toward the singular point c."""
+    tot = 0.0
+    if toward_hi:
+        far, near = c - lo, c - hi
+    else:
+        far, near = hi - c, lo - c
+    floor = far * 0.25 ** (m_graded - 1)
+    d0 = far
+    for _ in range(200):
+        d1 = 0.25 * d0
+        last = d1 <= near or d1 <= floor
+        if last:
+            d1 = near
+        sq = last and sq_end and near == 0.0
+        if toward_hi:
+            tot += _history_panel(c - d0, c - d1, k, False, sq, ctx, rh, cr, hist, n, segs, deg, gx,
+                          gw, w, dw)
+        else:
+            tot += _history_panel(c + d1, c + d0, k, sq, False, ctx, rh, cr, hist, n, segs, deg, gx,
+                          gw, w, dw)
+        if last:
+            break
+        d0 = d1
+    return tot
+
+
+@njit(cache=True)
+def memory_start(T, cr):
+    lam_min = math.inf
+    for i in range(2, cr.size, 2):
+        lam_min = min(lam_min, cr[i])
+    if lam_min > 0.0 and T - DECAYS / lam_min > 0.0:
+        return T - DECAYS / lam_min
+    return 0.0
+
+
+@njit(cache=True)
+def _interval_of(s, hist, n):
+    """the history interval k (nodes k, k+1, of positive length) holding s."""
+    a, b = 0, n - 1
+    while b - a > 1:
+        mid = (a + b) // 2
+        if hist[0, mid] <= s:
+            a = mid
+        else:
+            b = mid
+    return a
+
+
+@njit(cache=True)
+def _panel_edges(T, t_on, cr, hist, n, s0, pos, kidx):
+    """Panel edges in [s0, T] (sorted) and the interval of the panel each one starts."""
+    c = 0
+    pos[c], kidx[c] = s0, -1 if s0 < t_on else _interval_of(s0, hist, n)
+    c += 1
+    for i in range(2, cr.size, 2):
+        lam = cr[i]
+        if lam <= 0.0:
+            continue
+        for j in range(DECAY_EDGES.size):
+            s = T - DECAY_EDGES[j] / lam
+            if s > s0:
+                pos[c], kidx[c] = s, -1 if s < t_on else _interval_of(s, hist, n)
+                c += 1
+    for j in range(n - 1):
+        if hist[0, j] >= s0 and hist[0, j + 1] > hist[0, j]:
+            pos[c], kidx[c] = hist[0, j], j
+            c += 1
+    order = np.argsort(pos[:c], kind="mergesort")
+    p2 = pos[:c][order].copy()
+    k2 = kidx[:c][order].copy()
+    m = 0
+    for i in range(c):
+        if m > 0 and p2[i] == pos[m - 1]:
+            kidx[m - 1] = max(kidx[m - 1], k2[i])
+            continue
+        pos[m], kidx[m] = p2[i], k2[i]
+        m += 1
+    pos[m], kidx[m] = T, -2
+    return m + 1
+
+
+@njit(cache=True)
+def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
+    """The panels' edges from ``s_from`` on, sorted: ``(pos [s], interval of the panel
+    starting there (-1: before the onset), kind)``; kind 1 marks ``T`` and the times where
+    ``b_s = b_T`` (a log in the integrand), 0 those where ``a_s = b_T`` (a square root), -1 a
+    plain edge."""
+    T = ctx[2]
+    cap = 2 * n + 32
+    base = np.empty(cap)
+    bk = np.empty(cap, dtype=np.int64)
+    m = _panel_edges(T, ctx[0], cr, hist, n, memory_start(T, cr), base, bk)
+    first = 0
+    while first < m - 2 and base[first + 1] <= s_from:
+        first += 1
+    pos = np.empty(2 * m + 8)
+    kidx = np.empty(2 * m + 8, dtype=np.int64)
+    kind = np.empty(2 * m + 8, dtype=np.int64)
+    f_lo = np.empty(2)
+    f_hi = np.empty(2)
+    for which in range(2):
+        f_lo[which] = _crossing_at_edge(base[first], bk[first], which, ctx, rh, hist, n, segs,
+                                        deg, w, dw)
+    c = 0
+    for i in range(first, m - 1):
+        lo, hi, k = base[i], base[i + 1], bk[i]
+        pos[c], kidx[c], kind[c] = lo, k, -1
+        c += 1
+        for which in range(2):
+            # (the value at hi, on this panel's interval: a join of pieces is continuous)
+            f_hi[which] = _crossing_at_edge(hi, k, which, ctx, rh, hist, n, segs, deg, w, dw)
+            if (f_lo[which] < 0.0) != (f_hi[which] < 0.0) and f_lo[which] != 0.0 \
+                    and f_hi[which] != 0.0:
+                pos[c] = _crossing_time(lo, hi, f_lo[which], f_hi[which], k, which, ctx, rh,
+                                        hist, n, segs, deg, w, dw)
+                kidx[c], kind[c] = k, which
+                c += 1
+            f_lo[which] = f_hi[which]
+    pos[c], kidx[c], kind[c] = T, -2, 1
+    c += 1
+    order = np.argsort(pos[:c], kind="mergesort")
+    return pos[order], kidx[order], kind[order]
+
+
+@njit(cache=True)
+def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_hi):
+    """``int_{s_lo}^{s_hi} J'(T - s) opening(s, T) ds`` (``s_hi <= T``): Gauss panels between
+    the history's nodes, graded geometrically toward every singular point closer than three
+    panel widths (:func:`_singular_points`), with ``u^2`` at a square root."""
+    w = np.empty(deg + 1)
+    dw = np.empty(deg + 1)
+    pos, kidx, kind = _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_lo)
+    c = pos.size
+    acc = 0.0
+    prev_c, prev_k = -math.inf, -1
+    for i in range(c - 1):
+        if kind[i] >= 0:
+            prev_c, prev_k = pos[i], kind[i]
+        lo, hi, k = max(pos[i], s_lo), min(pos[i + 1], s_hi), kidx[i]
+        if hi <= lo:
+            continue
+        next_c, next_k = math.inf, -1
+        for j in range(i + 1, c):
+            if kind[j] >= 0:
+                next_c, next_k = pos[j], kind[j]
+                break
+        width = hi - lo
+        need_l = (lo - prev_c) * 3.0 < width
+        need_r = (next_c - hi) * 3.0 < width
+        mid = 0.5 * (lo + hi) if need_l and need_r else (hi if need_l else lo)
+        if need_l:
+            acc += _graded_toward(lo, mid, k, prev_c, False, n_graded, prev_k == 0, ctx, rh,
+                                  cr, hist, n, segs, deg, gx, gw, w, dw)
+        if need_r:
+            acc += _graded_toward(mid, hi, k, next_c, True, n_graded, next_k == 0, ctx, rh,
+                                  cr, hist, n, segs, deg, gx, gw, w, dw)
+        if not (need_l or need_r):
+            acc += _history_panel(lo, hi, k, False, False, ctx, rh, cr, hist, n, segs, deg,
+                                  gx, gw, w, dw)
+    return acc
+
+
+@njit(cache=True)
+def local_terms(ctx, rh, cr):
+    """The instantaneous compliance's term and the Kelvin-Voigt lift step's impulse."""
+    zone, T, ell_T, r_T, P_T = int(ctx[1]), ctx[2], ctx[3], ctx[4], ctx[5]
+    total = cr[0] * opening_now(ell_T, r_T, P_T)
+    if cr[1] != 0.0:
+        r0 = 0.0
+        if zone == 1:
+            l0 = ell_of(0.0, rh)
+            r0 = l0 * l0
+        Q = P_T + r0 - r_T
+        if Q > 0.0:
+            total += cr[1] * creep_rate(T, cr) * math.atan2(math.sqrt(Q), math.sqrt(1.0 - r0))
+    return total
+
+
+@njit(cache=True)
+def edge_gap(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded):
+    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]."""
+    T = ctx[2]
+    total = local_terms(ctx, rh, cr)
+    if cr.size <= 2 or T <= 0.0:
+        return total
+    return total + history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded,
+                                    memory_start(T, cr), T)
+
+
+@njit(cache=True)
+def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part):
+    """part 0: the memory before s_split; 1: the rest (with the local terms)."""
+    T = ctx[2]
+    s0 = memory_start(T, cr)
+    if part == 0:
+        if cr.size <= 2 or T <= 0.0 or s_split <= s0:
+            return 0.0
+        return history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s0, s_split)
+    total = local_terms(ctx, rh, cr)
+    if cr.size <= 2 or T <= 0.0:
+        return total
+    return total + history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded,
+                                    max(s0, s_split), T)

@@ -1,0 +1,178 @@
+"""The flat punch to separation by quadrature over the radii's history
+(:mod:`pulloff.solvers.edge_quadrature`): its closed-form pieces, its agreement with the
+independent moving-edge reference (a different method: element displacements integrated
+adaptively over the elements), its convergence, and its routing.
+
+Tolerances are measured (rtol 1e-6, the reference's own estimates 2e-10 to 1.3e-9): on the
+shipped moving-edge configs and the reference's four scenes at other speeds the largest error
+of onset, separation and peak forces was 1.8e-7 (finite_punch_internal's separation time),
+with estimates 0.55-40x the error.
+"""
+
+import json
+import math
+from pathlib import Path
+
+import mpmath
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from pulloff import solvers
+from pulloff.io.scene_file import load_scene
+from pulloff.kernels import quadrature as kernels
+from pulloff.model.rheology import Spectrum
+from pulloff.solvers import edge_quadrature as edge
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+REFERENCE = json.loads((Path(__file__).parent / "data" / "edge_reference.json").read_text())
+#: Reference entry -> (config, overrides).
+SCENES = {
+    "separation_kv": ("separation_kv", []),
+    "seed_flat_punch": ("seed_flat_punch", []),
+    "sls_finite_punch": ("sls_finite_punch", []),
+    "prony_external": ("prony_external", []),
+    "finite_punch_internal": ("finite_punch_internal", []),
+    "separation_elastic": ("separation_elastic", []),
+    "separation_kv_v1e-2": ("separation_kv", ["loading.v=1e-2"]),
+    "sls_finite_punch_v1e-4": ("sls_finite_punch", ["loading.v=1e-4"]),
+}
+#: Scenes whose branch turns back while the bond holds (handed to the stepper).
+BOND_FOLDS = {
+    "sls_external_v1e-2": ("sls_finite_punch", ["loading.v=1e-2",
+                                                "geometry.cohesive_zone=external"]),
+    "sls_finite_punch_v1e-7": ("sls_finite_punch", ["loading.v=1e-7"]),
+}
+#: Our summary name -> the reference's.
+OUTPUTS = {"t_detach": "t_onset", "F_total_detach": "F_onset_total",
+           "t_separation": "t_separation", "F_peak_total": "F_peak_total",
+           "F_peak_contact": "F_peak_contact"}
+
+
+def scene_of(name, *extra):
+    config, overrides = {**SCENES, **BOND_FOLDS}[name]
+    return load_scene(CONFIGS / f"{config}.yaml",
+                      overrides=["model.until=separation", *overrides, *extra])
+
+
+def errors(summary, name):
+    ref = REFERENCE[name]
+    return {ours: abs(summary[ours] / ref[theirs] - 1.0) for ours, theirs in OUTPUTS.items()}
+
+
+# ------------------------------------------------------------------ closed-form pieces
+@settings(max_examples=60, deadline=None)
+@given(P=st.floats(1e-8, 10.0), ratio=st.floats(-0.999, 10.0), A=st.floats(0.0, 1.0))
+def test_the_zone_weight_is_its_integral(P, ratio, A):
+    """``zone_weight(P, d, A) = 1/2 int_0^min(P, P+d) sqrt(P-w)/sqrt((A+w)(P+d-w)) dw`` (both
+    branches, d of either sign, A = 0 for the zone alone): against 30-digit quadrature."""
+    d = ratio * P
+    mpmath.mp.dps = 30
+    P_, Q_, A_ = mpmath.mpf(P), mpmath.mpf(P) + mpmath.mpf(d), mpmath.mpf(A)
+    exact = 0.5 * mpmath.quad(lambda w: mpmath.sqrt(P_ - w) / mpmath.sqrt((A_ + w) * (Q_ - w)),
+                              [0, min(P_, Q_)])
+    assert kernels.zone_weight(P, d, A) == pytest.approx(float(exact), rel=1e-13)
+
+
+@pytest.mark.parametrize("spectrum", [Spectrum(1e6, 0.0, ((9e6, 1e-3),)),
+                                      Spectrum(1e6, 0.0, ((4e6, 1e-4), (5e6, 1e-3))),
+                                      Spectrum(2e5, 0.0, ((1e6, 1e-2), (1e7, 1e-5), (3e5, 1.0)))])
+def test_the_creep_compliance_inverts_the_relaxation_modulus(spectrum):
+    """``G(t) J(0) + int_0^t G(t - s) J'(s) ds = 1`` at every t (``G * dJ = 1``), the
+    integral of the exponentials in closed form."""
+    J0, rates, weights = spectrum.creep()
+    for t in (1e-6, 1e-4, 1e-3, 2e-2, 3.0):
+        total = spectrum.modulus(t) * J0
+        for lam, w in zip(rates, weights):
+            total += w * spectrum.G_inf * -math.expm1(-lam * t) / lam
+            for G, tau in spectrum.arms:
+                total += w * G * (math.exp(-lam * t) - math.exp(-t / tau)) / (1.0 / tau - lam)
+        assert total == pytest.approx(1.0, rel=1e-12)
+    assert J0 == pytest.approx(1.0 / spectrum.instantaneous_modulus, rel=1e-15)
+
+
+# ------------------------------------------------------------------ against the reference
+@pytest.fixture(scope="module")
+def results():
+    return {name: solvers.simulate(scene_of(name, "numerics.rtol=1e-6")) for name in SCENES}
+
+
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_the_reference_agrees_within_rtol_with_an_honest_estimate(results, name):
+    res = results[name]
+    assert res.summary["solver"] == "edge_quadrature"
+    errs = errors(res.summary, name)
+    worst = max(errs.values())
+    assert worst <= 1e-6 / 4, errs  # measured at most 1.8e-7
+    assert res.error_estimate <= 1e-6
+    # honest: never below a tenth of the error (measured 0.55x at worst; the elastic punch
+    # is exact to rounding, estimate 0)
+    assert res.error_estimate >= 0.1 * worst or worst < 1e-14, (res.error_estimate, errs)
+
+
+def test_a_standard_linear_solid_holds_on_its_zone_alone_until_a_fold(results):
+    """sls_finite_punch: the bond goes (a = 0) before the zone comes off at a fold of the
+    zone-alone branch (MODEL.md 6, settled questions), both where the reference has them."""
+    run = edge.run_at(edge.EdgeModel.from_scene(scene_of("sls_finite_punch")), 1e-6, math.inf)
+    ref = REFERENCE["sls_finite_punch"]
+    ts = run.model.time_scale
+    assert run.end == "fold" and ref["separation_kind"] == "fold"
+    assert run.t_zero * ts == pytest.approx(ref["t_a_zero"], rel=1e-6)
+    assert run.t_zero * ts < results["sls_finite_punch"].t_separation
+
+
+def test_an_elastic_punch_comes_off_at_its_onset_with_the_closed_form_force(results):
+    res = results["separation_elastic"]
+    assert res.t_separation == res.t_detach
+    assert res.F_total_detach == pytest.approx(res.analytic["elastic_F_total"], rel=1e-12)
+    assert "unstable" in res.summary["notes"]
+
+
+def test_the_seed_scene_peaks_at_ten_times_its_onset_force(results):
+    res = results["seed_flat_punch"]
+    ratio = REFERENCE["seed_flat_punch"]["F_peak_total"] / REFERENCE["seed_flat_punch"][
+        "F_onset_total"]
+    assert res.F_peak_total / res.F_total_detach == pytest.approx(ratio, rel=1e-6)
+    assert 10.2 < ratio < 10.3
+
+
+# ------------------------------------------------------------------ convergence
+@pytest.mark.parametrize("name", ["separation_kv", "sls_finite_punch"])
+def test_errors_fall_with_the_tolerance_at_high_order_in_the_nodes(name):
+    """One run at tolerances 1e-3 .. 1e-6: the error of every output falls, and against the
+    history's node count at a high order (the predictor is of degree 5; measured 11.3 on
+    the standard linear solid and 6.5 on the Kelvin-Voigt punch, fitted over irregular
+    errors: asserted 4-16)."""
+    model = edge.EdgeModel.from_scene(scene_of(name))
+    rows = []
+    for tol in (1e-3, 1e-4, 1e-5, 1e-6):
+        run = edge.run_at(model, tol, math.inf)
+        rows.append((run.n, max(errors(edge.summarise(run), name).values())))
+    nodes, errs = np.array(rows).T
+    assert errs[-1] < 1e-7 and np.all(np.diff(np.log(errs)) < 0.0), rows
+    order = -np.polyfit(np.log(nodes), np.log(errs), 1)[0]
+    assert 4.0 <= order <= 16.0, (order, rows)
+
+
+# ------------------------------------------------------------------ routing
+def test_rigid_pulls_to_separation_are_routed_here_springs_and_steps_elsewhere():
+    assert solvers.route(scene_of("separation_kv")).name == "edge_quadrature"
+    assert solvers.route(scene_of("sls_finite_punch")).name == "edge_quadrature"
+    assert solvers.route(scene_of("separation_kv", "numerics.method=stepper")).name == "contact"
+    assert solvers.route(scene_of("separation_kv", "loading.machine_stiffness=100")).name == \
+        "contact"
+    assert solvers.route(load_scene(CONFIGS / "separation_kv.yaml",
+                                     overrides=["model.until=detach"])).name == \
+        "onset_quadrature"
+
+
+@pytest.mark.parametrize("name", sorted(BOND_FOLDS))
+def test_a_branch_turning_back_while_the_bond_holds_goes_to_the_stepper(name):
+    """A standard linear solid at 1e-2 m/s with the zone outside snaps 34 us after its onset
+    (the reference's fold, a real one); on the face at 1e-7 m/s the march turned back 10 ms
+    after its onset, where the reference's crack grows for 1.3 s (not understood). Both end
+    the march in a fold with the bond holding, which hands the scene to the contact solver
+    (checked by the march's ending: that solver takes seconds here)."""
+    run = edge.run_at(edge.EdgeModel.from_scene(scene_of(name)), 8e-4, math.inf)
+    assert run.end == "bond_fold"
+    assert math.isnan(run.t_zero)
