@@ -404,6 +404,35 @@ def _unstable_onset(run: March, r_on: float) -> bool:
     return g > 1.0 + 1e-12
 
 
+def _advance(run: March, ph: _Phase, piece: int, step: float):
+    """One step's try: ``(q, t, sigma, at_end, next step, accepted)``, or None where the
+    march has lost the branch (``run.end = "lost"``). The predictor's miss against the
+    tolerance sets the next step and rejects a step that missed by more than three times."""
+    n = run.n
+    sigma = run.hist[2, n - 1] + step
+    q_guess = _predict(run, piece, sigma, run.qs)
+    if q_guess >= ph.q_end:
+        t, sigma = _land_on_end(run, ph, piece, sigma)
+        return ph.q_end, t, sigma, True, step, True
+    q, t = _step(run, ph, sigma, q_guess, piece)
+    floor = _SMALLEST_STEP * abs(sigma)
+    if not (math.isfinite(t) and math.isfinite(q) and q <= ph.q_end):
+        # the secants went past a = 0 (or b = 0): land there, or take a shorter step
+        t, sigma = _land_on_end(run, ph, piece, sigma)
+        if math.isfinite(t) and t > run.hist[0, n - 1]:
+            return ph.q_end, t, sigma, True, step, True
+        if step <= floor:
+            run.end = "lost"
+            return None
+        return q, t, sigma, False, 0.25 * step, False
+    if n - piece <= DEGREE:
+        return q, t, sigma, False, 2.0 * step, True
+    miss = _miss(run, ph, q, q_guess, t)
+    factor = min(2.0, max(0.2, 0.8 * (run.tol / max(miss, 1e-300)) ** (1.0 / (DEGREE + 1))))
+    accepted = not (miss > 3.0 * run.tol and step > floor)
+    return q, t, sigma, False, max(step * factor, floor), accepted
+
+
 def march(run: March) -> None:
     """The receding and zone-alone phases from the onset to separation (``run.end``)."""
     model = run.model
@@ -419,37 +448,12 @@ def march(run: March) -> None:
     retries = 0
     while True:
         n = run.n
-        sigma = run.hist[2, n - 1] + step
-        q_guess = _predict(run, piece, sigma, run.qs)
-        at_end = q_guess >= ph.q_end
-        if at_end:
-            t, sigma = _land_on_end(run, ph, piece, sigma)
-            q = ph.q_end
-        else:
-            q, t = _step(run, ph, sigma, q_guess, piece)
-            if not (math.isfinite(t) and math.isfinite(q) and q <= ph.q_end):
-                # the secants went past a = 0 (or b = 0): land there, or take a shorter step
-                t, sigma = _land_on_end(run, ph, piece, sigma)
-                q, at_end = ph.q_end, True
-                if not (math.isfinite(t) and t > run.hist[0, n - 1]):
-                    if step <= _SMALLEST_STEP * abs(sigma):
-                        run.end = "lost"
-                        return
-                    step *= 0.25
-                    continue
-            if at_end:
-                pass
-            elif n - piece > DEGREE:
-                miss = _miss(run, ph, q, q_guess, t)
-                factor = min(2.0, max(0.2, 0.8 * (run.tol / max(miss, 1e-300))
-                                      ** (1.0 / (DEGREE + 1))))
-                floor = _SMALLEST_STEP * abs(sigma)
-                if miss > 3.0 * run.tol and step > floor:
-                    step = max(step * factor, floor)
-                    continue
-                step = max(step * factor, floor)
-            else:
-                step *= 2.0
+        attempt = _advance(run, ph, piece, step)
+        if attempt is None:
+            return
+        q, t, sigma, at_end, step, accepted = attempt
+        if not accepted:
+            continue
         p = ph.p_end if at_end else ph.p(q)
         if (t < run.hist[0, n - 1] and retries < _FOLD_RETRIES and not at_end
                 and step > _SMALLEST_STEP * abs(sigma)):
@@ -664,6 +668,10 @@ def run_at(model: EdgeModel, tol: float, t_limit: float) -> March:
         march(run)
     except _Steps:
         run.end = "steps"
+    except ZeroDivisionError:
+        # a degenerate trial history (two nodes at one sigma, as a slow standard linear solid
+        # at 5.2e-6 m/s gave): no answer from this march
+        run.end = "lost"
     return run
 
 
