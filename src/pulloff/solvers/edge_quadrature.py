@@ -350,7 +350,9 @@ def _miss(run: March, ph: _Phase, q: float, q_guess: float, t: float) -> float:
     """The predictor's miss: in the bond radius against the zone's width, in time against
     ``t``."""
     dq = abs(q - q_guess)
-    miss_t = dq * run.t_on / t
+    # in time against the time since the onset (but at least the fastest creep time): a
+    # slow pull's crack grows in e-folds of its memory, not of the pull's clock
+    miss_t = dq * run.t_on / max(t - run.t_on, min(run.model.fastest_creep, t))
     if ph.phase == 2:
         ell = run.model.ell(t)
         return max(abs(ph.p(q) - ph.p(q_guess)) / (ell * ell), miss_t)
