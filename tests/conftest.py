@@ -27,6 +27,7 @@ _FIRST = (
     "test_agreement.py",
     "test_solver.py",
     "test_quadrature.py",
+    "test_edge_quadrature.py",  # its own kernels (~5 s), none of the contact's
 )
 
 

@@ -236,6 +236,20 @@ def gaps(k, c, H0, path, span, times, n_graded, nodes, weights):
 
 
 @njit(cache=True)
+def _illinois(lo, hi, f_lo, f_hi, x, fx, side):
+    """One update of the Illinois bracket ``[lo, hi]`` (values ``f_lo``, ``f_hi`` of opposite
+    signs) by the new point ``x`` (value ``fx``): ``(lo, hi, f_lo, f_hi, side)``; the end
+    kept twice in a row has its value halved."""
+    if (fx < 0.0) == (f_lo < 0.0):
+        if side == -1:
+            f_hi *= 0.5
+        return x, hi, fx, f_hi, -1
+    if side == 1:
+        f_lo *= 0.5
+    return lo, x, f_lo, fx, 1
+
+
+@njit(cache=True)
 def detach_time(k, c, H0, path, span, lo, hi, g_lo, g_hi, n_graded, nodes, weights):
     """The root of ``gap = 1`` in ``[lo, hi]``, where ``g_lo = gap(lo) - 1 < 0 <= g_hi =
     gap(hi) - 1``, by the Illinois variant of regula falsi, to rounding: ``(T, slope,
@@ -254,16 +268,7 @@ def detach_time(k, c, H0, path, span, lo, hi, g_lo, g_hi, n_graded, nodes, weigh
         last = mid
         g_mid = gap(k, c, H0, path, span, mid, n_graded, nodes, weights) - 1.0
         n_eval += 1
-        if g_mid < 0.0:
-            lo, g_lo = mid, g_mid
-            if side == -1:
-                g_hi *= 0.5
-            side = -1
-        else:
-            hi, g_hi = mid, g_mid
-            if side == 1:
-                g_lo *= 0.5
-            side = 1
+        lo, hi, g_lo, g_hi, side = _illinois(lo, hi, g_lo, g_hi, mid, g_mid, side)
     slope = (g_hi - g_lo) / (hi - lo) if hi > lo else 0.0
     root = hi if g_hi == 0.0 or -g_lo > g_hi else lo
     return root, slope, n_eval
@@ -600,16 +605,7 @@ def _crossing_time(lo, hi, flo, fhi, k, which, ctx, rh, hist, n, segs, deg, w, d
             fx = _crossing_value(which, ell, r, P, ctx)
         if fx == 0.0:
             break
-        if (fx < 0.0) == (flo < 0.0):
-            lo, flo = x, fx
-            if side == -1:
-                fhi *= 0.5
-            side = -1
-        else:
-            hi, fhi = x, fx
-            if side == 1:
-                flo *= 0.5
-            side = 1
+        lo, hi, flo, fhi, side = _illinois(lo, hi, flo, fhi, x, fx, side)
     if k < 0:
         return x
     return _at_sigma(x, hist, i0, m, w, dw)[0]

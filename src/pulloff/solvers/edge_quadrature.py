@@ -38,7 +38,7 @@ import numpy as np
 
 from ..kernels import quadrature as kernels
 from ..model import analytic
-from .base import Solver, problem as problem_line
+from .base import Solver, flat_punch_pull, problem as problem_line
 from .problem import Problem
 from .result import Result
 
@@ -689,17 +689,7 @@ class EdgeQuadratureSolver(Solver):
 
     def unsupported(self, scene) -> list[str]:
         why = "the quadrature to separation has no steps or element fields"
-        out = []
-        if scene.geometry.kind != "flat_punch":
-            out.append(problem_line("geometry.kind", scene.geometry.kind,
-                                    "the edge quadrature pulls a flat punch only"))
-        if scene.loading.kind != "constant_velocity":
-            out.append(problem_line("loading.kind", scene.loading.kind,
-                                    "the edge quadrature pulls at constant speed only"))
-        elif scene.loading.machine_stiffness is not None:
-            out.append(problem_line("loading.machine_stiffness",
-                                    scene.loading.machine_stiffness,
-                                    "the edge quadrature assumes a rigid machine"))
+        out = flat_punch_pull(scene, "edge quadrature", zones=("external", "internal"))
         if scene.model.until != "separation":
             out.append(problem_line("model.until", scene.model.until,
                                     "the edge quadrature runs to separation"))
