@@ -3,6 +3,13 @@ eighteenth session) against the moving-edge reference and the contact stepper, w
 thread.
 
     python benchmarks/edge_quadrature.py [--rtol 1e-4 1e-6] [--repeat 3] [--stepper]
+    python benchmarks/edge_quadrature.py --work-precision
+
+``--work-precision``: single marches (no check run) at tolerances 1e-3 .. 1e-7 on the five
+shipped pulls to separation: error against the reference and warm time, the figure
+``results/work_precision_edge.png`` with the fitted ``time ~ error^x`` and cost against the
+history's node count (``time ~ nodes^y``; the memory makes every step integrate the whole
+history, so y near 2 is expected).
 
 For each scene of ``tests/data/edge_reference.json`` pulled by a rigid machine (the shipped
 moving-edge configs and four at other speeds): the solver that ran it, the median warm time
@@ -69,13 +76,70 @@ def measure(name: str, rtol: float, repeat: int, method: str | None):
                 estimate=res.summary["error_estimate"], notes=res.summary["notes"])
 
 
+def work_precision(repeat: int):
+    import math
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from pulloff.solvers import edge_quadrature as edge
+
+    names = ["separation_kv", "finite_punch_internal", "sls_finite_punch", "prony_external",
+             "seed_flat_punch"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    lines = ["| scene | tol | nodes | warm time | worst error |", "|---|---|---|---|---|"]
+    fits = []
+    for name in names:
+        config, overrides = SCENES[name]
+        scene = load_scene(ROOT / "configs" / f"{config}.yaml",
+                           overrides=overrides + ["model.until=separation"])
+        model = edge.EdgeModel.from_scene(scene)
+        ref = REFERENCE[name]
+        rows = []
+        for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
+            edge.run_at(model, tol, math.inf)
+            times = []
+            for _ in range(repeat):
+                start = time.perf_counter()
+                run = edge.run_at(model, tol, math.inf)
+                times.append(time.perf_counter() - start)
+            summary = edge.summarise(run)
+            error = max(abs(summary[ours] / ref[theirs] - 1.0)
+                        for ours, theirs in OUTPUTS.items())
+            rows.append((run.n, statistics.median(times), error))
+            lines.append(f"| {name} | {tol:g} | {run.n} | {rows[-1][1] * 1e3:.1f} ms | "
+                         f"{error:.1e} |")
+            print(lines[-1], flush=True)
+        nodes, times, errors = (np.array(c) for c in zip(*rows))
+        x = np.polyfit(np.log(errors), np.log(times), 1)[0]
+        y = np.polyfit(np.log(nodes), np.log(times), 1)[0]
+        fits.append(f"{name}: time ~ error^{x:.2f}, time ~ nodes^{y:.2f}")
+        ax.loglog(times, errors, "o-", label=f"{name} (time ~ error^{x:.2f})")
+    ax.set_xlabel("warm time of one march [s]")
+    ax.set_ylabel("worst relative error vs reference")
+    ax.set_title("pull to separation by quadrature")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(ROOT / "benchmarks" / "results" / "work_precision_edge.png", dpi=110)
+    text = "\n".join(lines + [""] + fits) + "\n"
+    (ROOT / "benchmarks" / "results" / "work_precision_edge.txt").write_text(text)
+    print("\n".join(fits))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rtol", type=float, nargs="+", default=[1e-4, 1e-6])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--stepper", action="store_true")
     ap.add_argument("--only", nargs="*", default=None)
+    ap.add_argument("--work-precision", action="store_true")
     args = ap.parse_args(argv)
+    if args.work_precision:
+        work_precision(args.repeat)
+        return
     lines = ["| scene | rtol | solver | warm median (min-max) | first run | worst error | "
              "estimate |", "|---|---|---|---|---|---|---|"]
     for name in args.only or SCENES:
