@@ -99,17 +99,17 @@ def work_precision(repeat: int):
         ref = REFERENCE[name]
         rows = []
         for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
-            edge.run_at(model, tol, math.inf)
+            edge.run_near(model, tol, math.inf)
             times = []
             for _ in range(repeat):
                 start = time.perf_counter()
-                run = edge.run_at(model, tol, math.inf)
+                run = edge.run_near(model, tol, math.inf)
                 times.append(time.perf_counter() - start)
             summary = edge.summarise(run)
             error = max(abs(summary[ours] / ref[theirs] - 1.0)
                         for ours, theirs in OUTPUTS.items())
             rows.append((run.n, statistics.median(times), error))
-            lines.append(f"| {name} | {tol:g} | {run.n} | {rows[-1][1] * 1e3:.1f} ms | "
+            lines.append(f"| {name} | {run.tol:g} | {run.n} | {rows[-1][1] * 1e3:.1f} ms | "
                          f"{error:.1e} |")
             print(lines[-1], flush=True)
         nodes, times, errors = (np.array(c) for c in zip(*rows))
