@@ -447,7 +447,7 @@ def march(run: March) -> None:
     ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
     run.push(run.t_on, r_on, 1.0, 0.0, new_piece=2)
     piece, step = 0, _FIRST_STEP
-    retries = 0
+    retries, crossed = 0, False
     while True:
         n = run.n
         attempt = _advance(run, ph, piece, step)
@@ -464,10 +464,13 @@ def march(run: March) -> None:
             retries += 1
             continue
         if t < run.hist[0, n - 1]:
-            if n - piece <= DEGREE:
-                # turned back within a phase's first steps (the seed scene's zone alone at
-                # tolerance 1e-7, where finer and coarser marches collapse): no fold this
-                # march can place
+            if n - piece <= DEGREE or (ph.phase == 3 and crossed):
+                # Turned back within a phase's first steps (the seed scene's zone alone at
+                # tolerance 1e-7, where finer and coarser marches collapse), or after the
+                # zone alone passed the onset's bond radius (separation_kv lifted by 1.5e-6 m
+                # at 1e-2 m/s, at tolerance 1e-6 only, 1.6 % before the reference's collapse;
+                # every real fold met so far, the zone's on the face and outside, came
+                # before any such crossing of the zone alone): no fold this march can place
                 run.end = "lost"
                 return
             run.push(t, p, sigma, q)
@@ -479,12 +482,13 @@ def march(run: March) -> None:
             return
         before = _zone_past_bond(run, run.hist[0, n - 1], run.hist[1, n - 1], ph.phase, a_on2)
         after = _zone_past_bond(run, t, p, ph.phase, a_on2)
-        if before > 1e-12 * a_on2 and after < 0.0 and not at_end:
+        if before > 0.0 and after < 0.0 and not at_end and not crossed:
             q, t, sigma = _land_on_kink(run, ph, piece, sigma, before, after, a_on2)
             run.push(t, ph.p(q), sigma, q)
             piece = run.n
             run.push(t, ph.p(q), sigma, q, new_piece=ph.phase)
             step = 100.0 * _FIRST_STEP
+            crossed = True  # (once a phase: the landing's own rounding is no second crossing)
             continue
         run.push(t, p, sigma, q)
         retries = 0
@@ -496,7 +500,7 @@ def march(run: March) -> None:
         run.t_zero = t
         b0 = model.ell(t) ** 2
         ph = _Phase(3, b0, 0.0)
-        piece = run.n
+        piece, crossed = run.n, False
         run.push(t, b0, t / run.t_on, 0.0, new_piece=3)
         step = _FIRST_STEP
 
