@@ -202,3 +202,17 @@ def test_a_zone_alone_passing_the_bond_radius_is_no_fold():
     res = solvers.simulate(scene_of("separation_kv", "numerics.rtol=1e-6", "loading.h0=1.5e-6",
                                     "loading.v=1e-2"))
     assert res.t_separation == pytest.approx(1.0049063201714853e-3, rel=1e-6)
+
+
+def test_an_elastic_punch_lifted_past_its_onset_comes_off_at_once():
+    """An elastic solid lifted at t = 0 beyond its onset's lift comes off at t = 0 with the
+    force of that state, ``2 sigma_c R^2 [ell + (1 + ell^2) atan(ell)]``, ``ell = 2 G h0 /
+    (sigma_c R)`` (a review found the march lost there and the stepper reporting nan times
+    and an 800x force; the reference: 1.507e-3 N at t = 0)."""
+    res = solvers.simulate(scene_of("separation_kv", "material={kind: elastic, G: 1.0e6}",
+                                    "loading.h0=1e-5", "numerics.rtol=1e-5"))
+    ell = 2.0 * 1e6 * 1e-5 / (1e6 * 1e-5)
+    assert res.summary["solver"] == "edge_quadrature"
+    assert res.t_detach == 0.0 and res.t_separation == 0.0
+    assert res.F_total_detach == pytest.approx(
+        2.0 * 1e6 * 1e-10 * (ell + (1.0 + ell * ell) * math.atan(ell)), rel=1e-13)

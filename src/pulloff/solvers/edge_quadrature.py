@@ -440,7 +440,7 @@ def march(run: March) -> None:
     model = run.model
     ell_on = model.ell(run.t_on)
     r_on = 0.0 if model.zone == 0 else ell_on ** 2
-    if run.t_on > 0.0 and _unstable_onset(run, r_on):
+    if _unstable_onset(run, r_on):
         run.end = "unstable_onset"
         return
     a_on2 = 1.0 - r_on
