@@ -505,34 +505,38 @@ def march(run: March) -> None:
         step = _FIRST_STEP
 
 
-def _fold(run: March, piece: int) -> tuple:
-    """``(t, sigma)`` of the largest ``t`` of the interpolant through the last nodes (the
-    last one past the fold)."""
-    n = run.n
-    m = min(n - piece, DEGREE + 1)
-    hs, ht = run.hist[2], run.hist[0]
-    lo, hi = hs[max(n - 3, n - m)], hs[n - 1]
+def _largest(f, lo: float, hi: float) -> float:
+    """The argument of the largest ``f`` in ``[lo, hi]`` (golden section; ``f`` unimodal
+    there)."""
     golden = 0.5 * (math.sqrt(5.0) - 1.0)
-
-    def t_at(s):
-        return kernels.lagrange(hs, ht, n - m, m, s)
-
     a, b = lo + (1 - golden) * (hi - lo), lo + golden * (hi - lo)
-    fa, fb = t_at(a), t_at(b)
+    fa, fb = f(a), f(b)
     for _ in range(200):
         if hi - lo <= 1e-15 * abs(hi):
             break
         if fa > fb:
             hi, b, fb = b, a, fa
             a = lo + (1 - golden) * (hi - lo)
-            fa = t_at(a)
+            fa = f(a)
         else:
             lo, a, fa = a, b, fb
             b = lo + golden * (hi - lo)
-            fb = t_at(b)
-    s = 0.5 * (lo + hi)
-    best = max((t_at(s), s), (ht[n - 2], hs[n - 2]))
-    return best
+            fb = f(b)
+    return 0.5 * (lo + hi)
+
+
+def _fold(run: March, piece: int) -> tuple:
+    """``(t, sigma)`` of the largest ``t`` of the interpolant through the last nodes (the
+    last one past the fold)."""
+    n = run.n
+    m = min(n - piece, DEGREE + 1)
+    hs, ht = run.hist[2], run.hist[0]
+
+    def t_at(s):
+        return kernels.lagrange(hs, ht, n - m, m, s)
+
+    s = _largest(t_at, hs[max(n - 3, n - m)], hs[n - 1])
+    return max((t_at(s), s), (ht[n - 2], hs[n - 2]))
 
 
 def _piece_of(run: March, i: int) -> tuple:
@@ -542,13 +546,19 @@ def _piece_of(run: March, i: int) -> tuple:
     return starts[j], starts[j + 1] - 1
 
 
+def _phases(run: March) -> np.ndarray:
+    """The phase (2 receding, 3 zone alone) of each node."""
+    phases = np.empty(run.n, dtype=np.int64)
+    for start, phase in run.segs:
+        phases[start:] = phase
+    return phases
+
+
 def _peak(run: March, which: int) -> tuple:
     """``(t, F)`` of the largest force (0: contact, 1: total) after the onset: the largest
     node, refined on its piece's interpolant in sigma."""
     model, hist, n = run.model, run.hist, run.n
-    phases = np.empty(n, dtype=np.int64)
-    for start, phase in run.segs:
-        phases[start:] = phase
+    phases = _phases(run)
     forces = np.array([model.forces(hist[0, i], hist[1, i], phases[i])[which]
                        for i in range(n)])
     if run.end == "fold":
@@ -559,24 +569,16 @@ def _peak(run: March, which: int) -> tuple:
         return hist[0, i], forces[i]
     m = min(last - first + 1, DEGREE + 1)
     i0 = min(max(i - m // 2, first), last - m + 1)
-    values = np.zeros(hist.shape[1])
-    values[i0:i0 + m] = forces[i0:i0 + m]
-    lo, hi = hist[2, i - 1], hist[2, i + 1]
-    golden = 0.5 * (math.sqrt(5.0) - 1.0)
-    for _ in range(200):
-        a, b = hi - golden * (hi - lo), lo + golden * (hi - lo)
-        if kernels.lagrange(hist[2], values, i0, m, a) > kernels.lagrange(hist[2], values, i0,
-                                                                          m, b):
-            hi = b
-        else:
-            lo = a
-        if hi - lo <= 1e-15 * abs(hi):
-            break
-    s = 0.5 * (lo + hi)
-    F = kernels.lagrange(hist[2], values, i0, m, s)
+    sigmas, values = hist[2, i0:i0 + m], forces[i0:i0 + m]
+
+    def force_at(s):
+        return kernels.lagrange(sigmas, values, 0, m, s)
+
+    s = _largest(force_at, hist[2, i - 1], hist[2, i + 1])
+    F = force_at(s)
     if F <= forces[i]:
         return hist[0, i], forces[i]
-    return kernels.lagrange(hist[2], hist[0], i0, m, s), F
+    return kernels.lagrange(sigmas, hist[0, i0:i0 + m], 0, m, s), F
 
 
 def _onset_contact_peak(run: March) -> tuple:
@@ -631,9 +633,7 @@ def history(run: March) -> dict:
     rows = []
     for t in np.linspace(0.0, t_first, ONSET_ROWS + 1)[:-1 if run.n else None]:
         rows.append((t, 0.0, 1, run.onset_gap(t)))
-    phases = np.empty(run.n, dtype=np.int64)
-    for start, phase in run.segs:
-        phases[start:] = phase
+    phases = _phases(run)
     last = run.n - 1 if run.end == "fold" else run.n
     for i in range(last):
         if i and run.hist[0, i] == run.hist[0, i - 1] and phases[i] == phases[i - 1]:
