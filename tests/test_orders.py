@@ -28,9 +28,12 @@ seed_flat_punch, separation       9.4e-6, 1.5e-6, 2.1e-7                        
 seed_flat_punch, peak             1.9e-6, 4.9e-7, 1.1e-7                        2.04
 ================================  =============================================  =====
 
-The seed scene's peak converged at order 1.07 over n = 64..256 (1.9e-6, 9.6e-7, 4.2e-7) until
-the elements its receding edge releases came at a spacing falling like ``1/n`` from n = 64 on
-(``contact_stepper.Stepper.per_release``; like ``1/sqrt(n)`` before).
+The seed scene (its rows above; its default solver is now the edge quadrature) needs the
+levels n = 64, 128, 256, 5 s of the suite: its check runs by hand with the stepper's other
+long checks (``python benchmarks/long_checks.py``). Its peak converged at order 1.07 over
+n = 64..256 (1.9e-6, 9.6e-7, 4.2e-7) until the elements its receding edge releases came at
+a spacing falling like ``1/n`` from n = 64 on (``contact_stepper.Stepper.per_release``; like
+``1/sqrt(n)`` before).
 
 The method is second order (quadratic paths of the edges and the lift over a step, Richardson
 with order 2 in ``solvers.contact.ORDER``). The band's floor, 1.75, is below the measured
@@ -47,7 +50,6 @@ then, 1.7e-5 now), so the fit reaches n = 128.
 
 import functools
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -67,9 +69,6 @@ SCENES = {
     "sls_finite_punch": ("sls_finite_punch", [], LEVELS),
     "sls_external_v1e-2": ("sls_finite_punch", ["loading.v=1e-2",
                                                 "geometry.cohesive_zone=external"], LEVELS),
-    # Its thin receding zone needs the finer levels (3.5 s): below n = 64 its peak converges
-    # at order ~1.4 (the released elements' spacing falls like 1/sqrt(n) there).
-    "seed_flat_punch": ("seed_flat_punch", [], (64, 128, 256)),
 }
 #: Our summary name -> the reference's.
 OUTPUTS = {"t_detach": "t_onset", "t_separation": "t_separation",

