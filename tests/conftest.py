@@ -24,6 +24,7 @@ _FIRST = (
     "test_rheology.py",
     "test_combinations.py",
     "test_edge_quadrature.py",
+    "test_edge_machine.py",
     "test_combinations_arms.py",
     "test_sweep.py",
     "test_orders.py",

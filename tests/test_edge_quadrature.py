@@ -156,12 +156,20 @@ def test_errors_fall_with_the_tolerance_at_high_order_in_the_nodes(name):
 
 
 # ------------------------------------------------------------------ routing
-def test_rigid_pulls_to_separation_are_routed_here_springs_and_steps_elsewhere():
+def test_pulls_to_separation_are_routed_here_steps_and_other_springs_elsewhere():
     assert solvers.route(scene_of("separation_kv")).name == "edge_quadrature"
     assert solvers.route(scene_of("sls_finite_punch")).name == "edge_quadrature"
     assert solvers.route(scene_of("separation_kv", "numerics.method=stepper")).name == "contact"
+    # through a machine spring: Kelvin-Voigt (or elastic), zone outside, no initial lift, a
+    # spring at most 10 times the solid's stiffness at the start (tests/test_edge_machine.py)
     assert solvers.route(scene_of("separation_kv", "loading.machine_stiffness=100")).name == \
-        "contact"
+        "edge_quadrature"
+    for extra in (["geometry.cohesive_zone=internal"],
+                  ["loading.machine_stiffness=1e5"]):
+        assert solvers.route(scene_of("separation_kv", "loading.machine_stiffness=100",
+                                      *extra)).name == "contact", extra
+    assert solvers.route(scene_of("sls_finite_punch", "loading.machine_stiffness=100")).name \
+        == "contact"
     assert solvers.route(load_scene(CONFIGS / "separation_kv.yaml",
                                      overrides=["model.until=detach"])).name == \
         "onset_quadrature"

@@ -212,7 +212,7 @@ def test_the_stepper_runs_what_needs_steps(overrides, solver):
      "output.snapshots"),
     ("seed_flat_punch", ["numerics.method=quadrature", "output.every=2"], "output.every"),
     ("seed_flat_punch", ["numerics.method=stepper", "numerics.rtol=1e-11"], "numerics.rtol"),
-    ("separation_kv", ["numerics.method=quadrature", "loading.machine_stiffness=100"],
+    ("separation_kv", ["numerics.method=quadrature", "loading.machine_stiffness=1e5"],
      "loading.machine_stiffness"),
     ("separation_kv", ["numerics.rtol=1e-11"], "numerics.rtol"),
     ("frozen_history", ["numerics.method=stepper"], "numerics.method"),

@@ -164,7 +164,7 @@ def test_a_row_without_its_history_is_the_row_with_it(overrides):
 def test_sweep_on_a_local_dask_cluster(seed):
     from distributed import LocalCluster  # the [dask] extra; part of the test extra too
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                   host="127.0.0.1", dashboard_address="127.0.0.1:0") as cluster:
         remote = sw.sweep(seed, ["loading.v=log:1e-4:1e-2:4"],
                           scheduler=cluster.scheduler_address)

@@ -397,7 +397,14 @@ def zone_weight(P, d, A):
 
 @njit(cache=True)
 def ell_of(s, rh):
-    """rh = [c0, cv, g_inf, eta, (g_i, tau_i)...]"""
+    """The bonded load ``ell`` at ``s`` while the bond radius is pinned: a rigid pull's
+    ``rh = [c0, cv, g_inf, eta, (g_i, tau_i)...]``, or a pull through a machine spring's lift
+    path (:mod:`pulloff.solvers.machine_lift`) ``rh = [nan, span, n + 1, nodes, H, S]``
+    (after the onset such a pull's ``ell`` is the history's: :func:`_node_state`)."""
+    if rh[0] != rh[0]:
+        size = int(rh[2])
+        return _barycentric(rh[3:3 + size], rh[3 + 2 * size:3 + 3 * size],
+                            math.sqrt(max(s, 0.0) / rh[1]))
     c0, cv, g_inf, eta = rh[0], rh[1], rh[2], rh[3]
     G = g_inf
     Gam = g_inf * s + eta
@@ -536,8 +543,10 @@ def _sigma_of(s, k, hist, i0, m, w, dw):
 
 @njit(cache=True)
 def _node_state(j, phase, hist, rh):
+    """``(ell, r, P)`` at node ``j``: ``ell`` the rigid pull's, or the history's fourth row
+    behind a machine spring (where the lift is solved for with the edges)."""
     t = hist[0, j]
-    ell = ell_of(t, rh)
+    ell = hist[3, j] if hist.shape[0] > 3 else ell_of(t, rh)
     if phase == 2:
         return ell, hist[1, j], ell * ell
     return ell, 1.0, hist[1, j]
@@ -545,9 +554,14 @@ def _node_state(j, phase, hist, rh):
 
 @njit(cache=True)
 def _state_sigma(x, phase, hist, i0, m, w, dw, rh):
-    """(s, ds/dsigma, ell, r, P) at sigma = x."""
+    """(s, ds/dsigma, ell, r, P) at sigma = x (``ell`` as :func:`_node_state`'s)."""
     t, dt, p = _at_sigma(x, hist, i0, m, w, dw)
-    ell = ell_of(t, rh)
+    if hist.shape[0] > 3:
+        ell = 0.0
+        for j in range(m):
+            ell += w[j] * hist[3, i0 + j]
+    else:
+        ell = ell_of(t, rh)
     if phase == 2:
         return t, dt, ell, p, ell * ell
     return t, dt, ell, 1.0, p
@@ -854,3 +868,75 @@ def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, p
         return total
     return total + history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded,
                                     max(s0, s_split), T)
+
+
+# --- the lift behind a machine spring while the bond recedes (solvers.edge_machine) -------------
+@njit(cache=True)
+def total_force(a, ell):
+    """``(f, df/dell)``: ``f = a ell + (a^2 + ell^2) atan2(ell, a)``, the whole line load
+    over ``2 sigma_c R^2`` with the edge condition ``b^2 = a^2 + ell^2``."""
+    angle = math.atan2(ell, a)
+    return a * ell + (a * a + ell * ell) * angle, 2.0 * (a + ell * angle)
+
+
+@njit(cache=True)
+def lift_step_weights(hist, first, i, rate, gx, gw, weights):
+    """``int e^(-rate (t_i - s)) ell(s) ds`` over the history's last interval (``i - 1``
+    to ``i``) is ``weights @ ell`` at the last ``m`` nodes of the piece from ``first`` (the
+    degree-5 interpolant in sigma, Gauss ``gx, gw`` on [0, 1]); returns ``m`` and writes
+    ``weights[:m]``."""
+    m = min(i - first + 1, 6)
+    i0 = i - m + 1
+    lo, hi = hist[2, i - 1], hist[2, i]
+    basis = np.empty(m)
+    dbasis = np.empty(m)
+    for j in range(m):
+        weights[j] = 0.0
+    for g in range(gx.size):
+        _basis(hist[2], i0, m, lo + (hi - lo) * gx[g], basis, dbasis)
+        s = 0.0
+        ds = 0.0
+        for j in range(m):
+            s += basis[j] * hist[0, i0 + j]
+            ds += dbasis[j] * hist[0, i0 + j]
+        factor = gw[g] * (hi - lo) * ds * math.exp(-rate * (hist[0, i] - s))
+        for j in range(m):
+            weights[j] += factor * basis[j]
+    return m
+
+
+@njit(cache=True)
+def receding_lift(hist, lifts, first, i, kappa, k, c, gx, gw):
+    """``(ell, H)`` at node ``i`` of a receding bond behind a machine spring (``hist`` rows
+    0-2 set there; ``ell = hist[3]`` and ``H = lifts`` at the earlier nodes): the force
+    balance ``kappa (t - H) = f(a, ell)`` with ``ell = k H + c dH/dt``, the lift as the
+    exponential integral of ``ell`` over the last interval (see ``solvers.edge_machine``);
+    Newton on ``ell`` from the last node's."""
+    t = hist[0, i]
+    a = math.sqrt(max(1.0 - hist[1, i], 0.0))
+    ell = hist[3, i - 1]
+    known = 0.0
+    w_new = 0.0
+    if c > 0.0:
+        weights = np.empty(6)
+        m = lift_step_weights(hist, first, i, k / c, gx, gw, weights)
+        known = math.exp(-k * (t - hist[0, i - 1]) / c) * lifts[i - 1]
+        for j in range(m - 1):
+            known += weights[j] * hist[3, i - m + 1 + j] / c
+        w_new = weights[m - 1] / c
+    for _ in range(60):
+        f, df = total_force(a, ell)
+        if c > 0.0:
+            g = t - f / kappa - known - w_new * ell
+            dg = -df / kappa - w_new
+        else:
+            g = ell / k - t + f / kappa
+            dg = 1.0 / k + df / kappa
+        ell_new = ell - g / dg
+        if ell_new <= 0.0:
+            ell_new = 0.5 * ell
+        done = abs(ell_new - ell) <= 1e-15 * ell
+        ell = ell_new
+        if done:
+            break
+    return ell, t - total_force(a, ell)[0] / kappa

@@ -39,6 +39,9 @@ import numpy as np
 from ..kernels import quadrature as kernels
 from ..model import analytic
 from .base import Solver, flat_punch_pull, problem as problem_line
+from . import edge_machine
+from .edge_machine import Machine
+from .onset_quadrature import _MAX_SPRING_TO_SOLID
 from .problem import Problem
 from .result import Result
 
@@ -86,9 +89,12 @@ class EdgeModel:
     time_scale: float  # s
     rh: np.ndarray  # the bonded load's law (kernels.ell_of)
     cr: np.ndarray  # the creep compliance (kernels.creep_rate)
+    machine: Machine | None = None  # a machine spring's (None: a rigid pull)
 
     @classmethod
-    def from_scene(cls, scene) -> "EdgeModel":
+    def from_scene(cls, scene, t_limit: float = math.inf) -> "EdgeModel":
+        """The scene's pull; behind a machine spring with the lift path to past its onset
+        (``t_limit`` in ``delta / v``; ``ValueError`` where there is none)."""
         spectrum = scene.material.spectrum()
         sigma_c, delta = scene.adhesion.sigma_c, scene.adhesion.delta
         R, v, h0 = scene.geometry.radius, scene.loading.v, scene.loading.h0
@@ -102,8 +108,12 @@ class EdgeModel:
         cr = [J0 * compliance, 2.0 * spectrum.eta * h0 / (sigma_c * R * ts)]
         for rate, weight in zip(rates, weights):
             cr += [rate * ts, weight * compliance * ts]
+        machine = None
+        if scene.loading.machine_stiffness is not None:
+            machine = Machine.from_scene(scene, t_limit)
+            rh = machine.law_array()
         return cls(R, sigma_c, delta, v, h0, 0 if scene.geometry.cohesive_zone == "external"
-                   else 1, ts, np.array(rh, float), np.array(cr, float))
+                   else 1, ts, np.array(rh, float), np.array(cr, float), machine)
 
     @property
     def fastest_creep(self) -> float:
@@ -112,26 +122,33 @@ class EdgeModel:
         return 1.0 / rates.max() if rates.size and rates.max() > 0.0 else math.inf
 
     def ell(self, t: float) -> float:
+        """The bonded load while the bond radius is pinned (a rigid pull's at any time)."""
         return kernels.ell_of(t, self.rh)
 
-    def state(self, t: float, p: float, phase: int):
+    def lift(self, t: float) -> float:
+        """The lift [delta] while the bond radius is pinned (a rigid pull's at any time)."""
+        if self.machine is not None:
+            return self.machine.lift_before(t)
+        return self.h0 / self.delta + t
+
+    def state(self, t: float, p: float, phase: int, ell: float | None = None):
         """``(ell, r, P)`` at ``t``: phase 1 pinned, 2 receding (``p = r``), 3 alone
-        (``p = b^2``)."""
-        ell = self.ell(t)
+        (``p = b^2``); ``ell`` given past the onset behind a machine spring."""
+        ell = self.ell(t) if ell is None else ell
         if phase == 1:
             return (ell, 0.0, ell * ell) if self.zone == 0 else (ell, ell * ell, ell * ell)
         return (ell, p, ell * ell) if phase == 2 else (ell, 1.0, p)
 
-    def radii(self, t: float, p: float, phase: int):
+    def radii(self, t: float, p: float, phase: int, ell: float | None = None):
         """``(a, b)`` in R."""
-        ell, r, P = self.state(t, p, phase)
+        ell, r, P = self.state(t, p, phase, ell)
         a = math.sqrt(max(1.0 - r, 0.0))
         return a, math.sqrt(a * a + P)
 
-    def forces(self, t: float, p: float, phase: int):
+    def forces(self, t: float, p: float, phase: int, ell: float | None = None):
         """``(F_contact, F_total)`` [N]: ``2 a L`` and the whole line load's."""
-        ell, r, P = self.state(t, p, phase)
-        a, b = self.radii(t, p, phase)
+        ell, r, P = self.state(t, p, phase, ell)
+        a, b = self.radii(t, p, phase, ell)
         unit = 2.0 * self.sigma_c * self.R ** 2
         total = a * ell + b * b * math.atan2(math.sqrt(P), a) if b > 0.0 else 0.0
         return unit * 2.0 * a * ell, unit * total
@@ -165,7 +182,7 @@ class March:
     t_limit: float = math.inf
     t_on: float = math.inf
     t_zero: float = math.nan  # when a reached 0
-    end: str = ""  # collapse | fold | unstable_onset | t_max | no_onset | steps
+    end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
     evaluations: int = 0
     n: int = 0
@@ -175,17 +192,26 @@ class March:
 
     def __post_init__(self):
         self.gx, self.gw, self.graded = _rule(self.tol)
-        self.hist = np.zeros((3, MAX_NODES + 2))
+        # behind a machine spring a fourth row: the bonded load (edge_machine)
+        self.machine = self.model.machine
+        self.hist = np.zeros((3 if self.machine is None else 4, MAX_NODES + 2))
         self.qs = np.zeros(MAX_NODES + 2)
+        self.lifts = np.zeros(MAX_NODES + 2)  # behind a machine spring: H at the nodes
+        self.zero = ()  # behind a machine spring: (t, H, ell) where a reached 0
         self.segs = np.zeros((0, 2), dtype=np.int64)
         self.ctx = np.zeros(6)
         self.ctx[1] = self.model.zone
 
+    def node_ell(self, i: int):
+        """The bonded load at node ``i`` behind a machine spring (None: a rigid pull's, a
+        function of time)."""
+        return None if self.machine is None else self.hist[3, i]
+
     # -- the gap -----------------------------------------------------------------------------
-    def _context(self, t, p, phase):
+    def _context(self, t, p, phase, ell=None):
         c = self.ctx
         c[0], c[2] = self.t_on, t
-        c[3], c[4], c[5] = self.model.state(t, p, phase)
+        c[3], c[4], c[5] = self.model.state(t, p, phase, ell)
         return c
 
     def onset_gap(self, t: float) -> float:
@@ -194,9 +220,10 @@ class March:
                                 self.hist, 0, self.segs, DEGREE, self.gx, self.gw,
                                 self.graded)
 
-    def _trial(self, t, p, sigma):
+    def _trial(self, t, p, sigma, phase):
         """The history with a trial node after the accepted ones: ``(hist, n)``. A trial
-        beyond a fold (earlier than the last node) sees the history before it only."""
+        beyond a fold (earlier than the last node) sees the history before it only. Behind
+        a machine spring the node's bonded load and lift (``self.trial_lift``) are solved."""
         i, hist = self.n, self.hist
         if i > 0 and hist[0, i - 1] >= t:
             hist = hist[:, :i + 1].copy()
@@ -204,27 +231,55 @@ class March:
             while i > first and hist[0, i - 1] >= t:
                 i -= 1
         hist[0, i], hist[1, i], hist[2, i] = t, p, sigma
+        if self.machine is not None:
+            hist[3, i], self.trial_lift = self._lift(hist, i, phase)
         return hist, i + 1
+
+    def _lift(self, hist, i, phase):
+        """``(ell, H)`` at node ``i`` behind the machine spring (its rows 0-2 set)."""
+        if phase == 3:
+            return self.zero[2], self.machine.lift_alone(hist[0, i], hist[1, i])
+        return self.machine.receding(hist, self.lifts, self.segs[-1, 0], i)
+
+    def ell_at(self, t, p, sigma, phase):
+        """The bonded load at a point of the branch (the trial node's behind a spring)."""
+        if self.machine is None:
+            return self.model.ell(t)
+        hist, n = self._trial(t, p, sigma, phase)
+        return hist[3, n - 1]
 
     def gap(self, t, p, phase, sigma, part=-1, split=0.0):
         """``gap / delta`` with a trial node; ``part`` 0 / 1: the memory before / after
         ``split`` (:func:`kernels.edge_gap_split`), -1 all of it."""
-        hist, n = self._trial(t, p, sigma)
+        hist, n = self._trial(t, p, sigma, phase)
         self.evaluations += 1
         m = self.model
-        args = (self._context(t, p, phase), m.rh, m.cr, hist, n, self.segs, DEGREE, self.gx,
-                self.gw, self.graded)
+        args = (self._context(t, p, phase, hist[3, n - 1] if self.machine else None),
+                m.rh, m.cr, hist, n, self.segs, DEGREE, self.gx, self.gw, self.graded)
+        alone = 0.0
+        if self.machine is not None and phase == 3 and part != 0:
+            # the punch moves with the zone; the virtual element crept (edge_machine)
+            alone = self.trial_lift - self.machine.virtual_lift(t, *self.zero)
         if part < 0:
-            return kernels.edge_gap(*args)
-        return kernels.edge_gap_split(*args, split, part)
+            return kernels.edge_gap(*args) + alone
+        return kernels.edge_gap_split(*args, split, part) + alone
 
     def push(self, t, p, sigma, q, new_piece=None):
+        """A node; behind a machine spring with its bonded load and lift (a piece's first
+        node: the one before it at the same time, or the path's before the onset)."""
         i = self.n
         if i >= MAX_NODES:
             raise _Steps()
         if new_piece is not None:
             self.segs = np.vstack([self.segs, [[i, new_piece]]]).astype(np.int64)
-        self.hist[:, i] = t, p, sigma
+        self.hist[:3, i] = t, p, sigma
+        if self.machine is not None:
+            if new_piece is None:
+                self.hist[3, i], self.lifts[i] = self._lift(self.hist, i, self.segs[-1, 1])
+            elif i > 0 and self.hist[0, i - 1] == t:
+                self.hist[3, i], self.lifts[i] = self.hist[3, i - 1], self.lifts[i - 1]
+            else:
+                self.hist[3, i], self.lifts[i] = self.model.ell(t), self.model.lift(t)
         self.qs[i] = q
         self.n = i + 1
 
@@ -354,15 +409,19 @@ def _miss(run: March, ph: _Phase, q: float, q_guess: float, t: float) -> float:
     # slow pull's crack grows in e-folds of its memory, not of the pull's clock
     miss_t = dq * run.t_on / max(t - run.t_on, min(run.model.fastest_creep, t))
     if ph.phase == 2:
-        ell = run.model.ell(t)
+        ell = run.model.ell(t) if run.machine is None else run.hist[3, run.n - 1]
         return max(abs(ph.p(q) - ph.p(q_guess)) / (ell * ell), miss_t)
     return max(dq, miss_t)
 
 
-def _zone_past_bond(run: March, t: float, p: float, phase: int, a_on2: float) -> float:
-    """``b^2 - a_onset^2``: its sign change is a kink of the openings (see the module)."""
-    ell = run.model.ell(t)
-    return (1.0 - p + ell * ell if phase == 2 else p) - a_on2
+def _zone_past_bond(run: March, t: float, p: float, phase: int, a_on2: float,
+                    sigma: float) -> float:
+    """``b^2 - a_onset^2`` at a point of the branch: its sign change is a kink of the
+    openings (see the module)."""
+    if phase == 3:
+        return p - a_on2
+    ell = run.ell_at(t, p, sigma, phase)
+    return 1.0 - p + ell * ell - a_on2
 
 
 def _land_on_end(run: March, ph: _Phase, piece: int, sigma: float) -> tuple:
@@ -387,7 +446,7 @@ def _land_on_kink(run: March, ph: _Phase, piece: int, sigma: float, before: floa
     def residual(s):
         q, t = _step(run, ph, s, _predict(run, piece, s, run.qs), piece)
         found[s] = (q, t)
-        return _zone_past_bond(run, t, ph.p(q), ph.phase, a_on2)
+        return _zone_past_bond(run, t, ph.p(q), ph.phase, a_on2, s)
 
     s = illinois(residual, run.hist[2, run.n - 1], sigma, before, after, 1e-15 * abs(sigma))
     q, t = found[s] if s in found else _step(run, ph, s, _predict(run, piece, s, run.qs),
@@ -404,6 +463,17 @@ def _unstable_onset(run: March, r_on: float) -> bool:
     g = run.gap(run.t_on, r_on + dr, 2, 1e-9 * dr / width)
     run.n, run.segs = 0, run.segs[:0]
     return g > 1.0 + 1e-12
+
+
+def _snaps_at_a_zero(run: March, t: float, b0: float) -> bool:
+    """Behind a machine spring, whether the zone alone cannot hold the punch where ``a``
+    reaches 0: the gap's slope in ``b^2`` at that time, the punch moving with the zone (the
+    moving-edge reference's criterion: a smaller zone must close the gap)."""
+    eps = 1e-4 * b0
+    sigma = run.hist[2, run.n - 1]
+    near = run.gap(t, b0 - 1e-3 * eps, 3, sigma + 1e-12 * abs(sigma))
+    far = run.gap(t, b0 - eps, 3, sigma + 2e-12 * abs(sigma))
+    return not (near - far) / (0.999 * eps) > 0.0
 
 
 def _advance(run: March, ph: _Phase, piece: int, step: float):
@@ -480,8 +550,11 @@ def march(run: March) -> None:
         if t > run.t_limit:
             run.end = "t_max"
             return
-        before = _zone_past_bond(run, run.hist[0, n - 1], run.hist[1, n - 1], ph.phase, a_on2)
-        after = _zone_past_bond(run, t, p, ph.phase, a_on2)
+        before = (_zone_past_bond(run, run.hist[0, n - 1], run.hist[1, n - 1], ph.phase,
+                                  a_on2, run.hist[2, n - 1])
+                  if run.machine is None or ph.phase == 3 else
+                  1.0 - run.hist[1, n - 1] + run.hist[3, n - 1] ** 2 - a_on2)
+        after = _zone_past_bond(run, t, p, ph.phase, a_on2, sigma)
         if before > 0.0 and after < 0.0 and not at_end and not crossed:
             q, t, sigma = _land_on_kink(run, ph, piece, sigma, before, after, a_on2)
             run.push(t, ph.p(q), sigma, q)
@@ -498,10 +571,15 @@ def march(run: March) -> None:
             run.end = "collapse"
             return
         run.t_zero = t
-        b0 = model.ell(t) ** 2
+        b0 = (model.ell(t) if run.machine is None else run.hist[3, run.n - 1]) ** 2
         ph = _Phase(3, b0, 0.0)
         piece, crossed = run.n, False
+        if run.machine is not None:
+            run.zero = (t, run.lifts[run.n - 1], run.hist[3, run.n - 1])
         run.push(t, b0, t / run.t_on, 0.0, new_piece=3)
+        if run.machine is not None and _snaps_at_a_zero(run, t, b0):
+            run.end = "snap"
+            return
         step = _FIRST_STEP
 
 
@@ -559,7 +637,7 @@ def _peak(run: March, which: int) -> tuple:
     node, refined on its piece's interpolant in sigma."""
     model, hist, n = run.model, run.hist, run.n
     phases = _phases(run)
-    forces = np.array([model.forces(hist[0, i], hist[1, i], phases[i])[which]
+    forces = np.array([model.forces(hist[0, i], hist[1, i], phases[i], run.node_ell(i))[which]
                        for i in range(n)])
     if run.end == "fold":
         forces[-1] = -math.inf  # past the fold
@@ -605,14 +683,16 @@ def summarise(run: March) -> dict:
     t = run.t_on
     a, b = model.radii(t, 0.0, 1)
     Fc, Ft = model.forces(t, 0.0, 1)
-    out.update(t_detach=t * ts, h_detach=model.h0 + model.v * t * ts, b_detach=b * model.R,
+    h_on = (model.h0 + model.v * t * ts if model.machine is None
+            else model.lift(t) * model.delta)
+    out.update(t_detach=t * ts, h_detach=h_on, b_detach=b * model.R,
                zone_ratio_detach=(b - a) / a if a > 0.0 else math.nan, F_contact_detach=Fc,
                F_total_detach=Ft)
     if run.end == "unstable_onset":
         out.update(t_separation=t * ts, F_peak_total=Ft, t_peak_total=t * ts,
                    F_peak_contact=Fc, t_peak_contact=t * ts)
         return out
-    if run.end in ("collapse", "fold"):
+    if run.end in ("collapse", "fold", "snap"):
         out["t_separation"] = (run.fold[0] if run.end == "fold" else run.hist[0, run.n - 1]) * ts
     tc, Fcp = max(_onset_contact_peak(run), _peak(run, 0), key=lambda x: x[1])
     tt, Ftp = max((t, Ft), _peak(run, 1), key=lambda x: x[1])
@@ -630,27 +710,32 @@ def history(run: March) -> dict:
     is delta there) and the fold."""
     model, ts = run.model, run.model.time_scale
     t_first = run.t_on if math.isfinite(run.t_on) else run.t_limit
+    rigid = model.machine is None
     rows = []
     for t in np.linspace(0.0, t_first, ONSET_ROWS + 1)[:-1 if run.n else None]:
-        rows.append((t, 0.0, 1, run.onset_gap(t)))
+        rows.append((t, 0.0, 1, run.onset_gap(t), None, None if rigid else model.lift(t)))
     phases = _phases(run)
     last = run.n - 1 if run.end == "fold" else run.n
     for i in range(last):
         if i and run.hist[0, i] == run.hist[0, i - 1] and phases[i] == phases[i - 1]:
             continue  # a piece boundary's second copy
-        rows.append((run.hist[0, i], run.hist[1, i], phases[i], 1.0))
+        rows.append((run.hist[0, i], run.hist[1, i], phases[i], 1.0, run.node_ell(i),
+                     None if rigid else run.lifts[i]))
     out = {name: [] for name in ("t", "h", "a", "b", "gap", "F_contact", "F_total")}
-    for t, p, phase, gap in rows:
-        a, b = model.radii(t, p, phase)
-        Fc, Ft = model.forces(t, p, phase)
-        for name, value in zip(out, (t * ts, model.h0 + model.v * t * ts, a * model.R,
-                                     b * model.R, gap * model.delta, Fc, Ft)):
+    for t, p, phase, gap, ell, lift in rows:
+        a, b = model.radii(t, p, phase, ell)
+        Fc, Ft = model.forces(t, p, phase, ell)
+        h = model.h0 + model.v * t * ts if rigid else lift * model.delta
+        for name, value in zip(out, (t * ts, h, a * model.R, b * model.R, gap * model.delta,
+                                     Fc, Ft)):
             out[name].append(value)
     if run.end == "fold":
         for name in out:
             out[name].append(out[name][-1])
         out["t"][-1] = run.fold[0] * ts
-        out["h"][-1] = model.h0 + model.v * run.fold[0] * ts
+        out["h"][-1] = (model.h0 + model.v * run.fold[0] * ts if rigid else
+                        model.machine.lift_alone(run.fold[0], run.hist[1, run.n - 1])
+                        * model.delta)
     return {name: np.array(values) for name, values in out.items()}
 
 
@@ -683,6 +768,8 @@ def run_at(model: EdgeModel, tol: float, t_limit: float) -> March:
     """One run: the onset, then the march (``run.end`` says how it ended)."""
     run = March(model, tol, t_limit)
     run.t_limit = min(t_limit, strength_time(model, t_limit))
+    if model.machine is not None:  # (its lift path holds the onset: machine_lift)
+        run.t_limit = min(run.t_limit, model.machine.span)
     find_onset(run)
     run.t_limit = t_limit
     if run.end == "no_onset":
@@ -711,18 +798,24 @@ def _handed_over(run: March, model: EdgeModel, t_limit: float) -> bool:
 
 
 class EdgeQuadratureSolver(Solver):
-    """A flat punch pulled to separation by a rigid machine, the zone outside or on the face,
-    any rheology, by quadrature over the history of its radii (no mesh, no fixed steps)."""
+    """A flat punch pulled to separation, the zone outside or on the face, any rheology, by
+    quadrature over the history of its radii (no mesh, no fixed steps); through a machine
+    spring a Kelvin-Voigt or elastic solid with the zone outside (:mod:`.edge_machine`)."""
 
     name = "edge_quadrature"
     method = "quadrature"
     kernel = "quadrature.edge_gap_split"
     summary = ("flat punch to separation by quadrature over the radii's history (rigid "
-               "machine, any rheology, zone outside or on the face)")
+               "machine, any rheology, zone outside or on the face; through a machine "
+               "spring, Kelvin-Voigt with the zone outside)")
 
     def unsupported(self, scene) -> list[str]:
         why = "the quadrature to separation has no steps or element fields"
-        out = flat_punch_pull(scene, "edge quadrature", zones=("external", "internal"))
+        out = flat_punch_pull(scene, "edge quadrature", zones=("external", "internal"),
+                              machine=True)
+        if not out and scene.loading.machine_stiffness is not None:
+            out += [problem_line(*line) for line in edge_machine.problems(
+                scene, _MAX_SPRING_TO_SOLID)]
         if scene.model.until != "separation":
             out.append(problem_line("model.until", scene.model.until,
                                     "the edge quadrature runs to separation"))
@@ -743,10 +836,14 @@ class EdgeQuadratureSolver(Solver):
 
     def solve(self, scene, observers) -> Result:
         wall = time.perf_counter()
-        model = EdgeModel.from_scene(scene)
         rtol = scene.numerics.rtol
         t_limit = math.inf if scene.numerics.t_max is None else (
-            scene.numerics.t_max / model.time_scale)
+            scene.numerics.t_max * scene.loading.v / scene.adhesion.delta)
+        try:
+            model = EdgeModel.from_scene(scene, t_limit)
+        except ValueError:  # no lift path to an onset behind this spring
+            from .contact import ContactSolver
+            return ContactSolver().solve(scene, observers)
         with observers.progress("edge quadrature", None):
             coarse = run_near(model, _TOL_PER_RTOL * rtol, t_limit)
             fine = None
@@ -774,6 +871,9 @@ def _notes(run: March, scene, estimate: float) -> list:
         notes.append(f"{what} not reached before t_max = {scene.numerics.t_max:.6g} s")
     elif run.end == "steps":
         notes.append(f"stopped after {MAX_NODES} steps without separating")
+    elif run.end == "snap":
+        notes.append("the zone alone cannot hold the punch behind the machine spring where "
+                     "the bond radius reaches 0: it snaps off there")
     elif run.end == "unstable_onset":
         notes.append("the onset is unstable (a receding edge opens the gap further): the "
                      "punch comes off at once")
