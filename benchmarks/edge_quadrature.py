@@ -6,13 +6,15 @@ thread.
     python benchmarks/edge_quadrature.py --work-precision
 
 ``--work-precision``: single marches (no check run) at tolerances 1e-3 .. 1e-7 on the five
-shipped pulls to separation: error against the reference and warm time, the figure
+shipped pulls to separation and the compliant machine's: error against the reference and
+warm time, the figure
 ``results/work_precision_edge.png`` with the fitted ``time ~ error^x`` and cost against the
 history's node count (``time ~ nodes^y``; the memory makes every step integrate the whole
 history, so y near 2 is expected).
 
-For each scene of ``tests/data/edge_reference.json`` pulled by a rigid machine (the shipped
-moving-edge configs and four at other speeds): the solver that ran it, the median warm time
+For each scene of ``tests/data/edge_reference.json`` (the shipped moving-edge configs, four at
+other speeds, and the compliant machine's to separation behind 100, 10 and 1 N/m): the solver
+that ran it, the median warm time
 (compiling done by a first run, reported apart), its worst relative error of the onset time
 and force, the separation time and the two peak forces against the reference, and its
 estimate. ``--stepper`` adds the contact stepper (``numerics.method: stepper``) beside it.
@@ -49,6 +51,10 @@ SCENES = {
                                                 "geometry.cohesive_zone=external"]),
     "sls_finite_punch_v1e-4": ("sls_finite_punch", ["loading.v=1e-4"]),
     "sls_finite_punch_v1e-7": ("sls_finite_punch", ["loading.v=1e-7"]),
+    # through machine springs (since the nineteenth session)
+    "compliant_machine": ("compliant_machine", []),
+    "compliant_machine_k10": ("compliant_machine", ["loading.machine_stiffness=10"]),
+    "compliant_machine_k1": ("compliant_machine", ["loading.machine_stiffness=1"]),
 }
 OUTPUTS = {"t_detach": "t_onset", "F_total_detach": "F_onset_total",
            "t_separation": "t_separation", "F_peak_total": "F_peak_total",
@@ -87,7 +93,7 @@ def work_precision(repeat: int):
     from pulloff.solvers import edge_quadrature as edge
 
     names = ["separation_kv", "finite_punch_internal", "sls_finite_punch", "prony_external",
-             "seed_flat_punch"]
+             "seed_flat_punch", "compliant_machine"]
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     lines = ["| scene | tol | nodes | warm time | worst error |", "|---|---|---|---|---|"]
     fits = []
