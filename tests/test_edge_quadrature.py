@@ -24,6 +24,8 @@ from pulloff.kernels import quadrature as kernels
 from pulloff.model.rheology import Spectrum
 from pulloff.solvers import edge_quadrature as edge
 
+from edge_helpers import assert_agrees_with_the_reference
+
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 REFERENCE = json.loads((Path(__file__).parent / "data" / "edge_reference.json").read_text())
 #: Reference entry -> (config, overrides).
@@ -99,15 +101,9 @@ def results():
 
 @pytest.mark.parametrize("name", sorted(SCENES))
 def test_the_reference_agrees_within_rtol_with_an_honest_estimate(results, name):
-    res = results[name]
-    assert res.summary["solver"] == "edge_quadrature"
-    errs = errors(res.summary, name)
-    worst = max(errs.values())
-    assert worst <= 1e-6 / 4, errs  # measured at most 1.8e-7
-    assert res.error_estimate <= 1e-6
-    # honest: never below a tenth of the error (measured 0.55x at worst; the elastic punch
-    # is exact to rounding, estimate 0)
-    assert res.error_estimate >= 0.1 * worst or worst < 1e-14, (res.error_estimate, errs)
+    # measured at most 1.8e-7, estimates 0.55x the error at worst
+    assert_agrees_with_the_reference(results[name], errors(results[name].summary, name),
+                                     1e-6 / 4)
 
 
 def test_a_standard_linear_solid_holds_on_its_zone_alone_until_a_fold(results):
