@@ -126,3 +126,33 @@ def test_an_elastic_punch_behind_a_spring_comes_off_at_its_onset_with_the_closed
     assert res.t_separation == res.t_detach
     assert res.F_peak_total == res.F_total_detach
     assert res.F_total_detach == pytest.approx(exact["F_total"], rel=1e-9)
+
+
+def test_a_fast_pull_behind_a_stiff_spring_has_the_onset_quadratures_onset():
+    """300 N/m at 0.1 m/s (the spring 3.75 times the solid at the start): the lift path
+    starts like ``sqrt(t)`` over a layer a fair part of the onset time, which the gap's
+    history integral must grade toward ``t = 0`` (found by a review: the onset was 2.0e-6
+    off at rtol 1e-6 and 3.2e-5 at 1e-5, estimates 1.5e-8 and 2.8e-8; now 1e-13 and 1.2e-10).
+    The onset's own quadrature lays its panels out differently (its ``Span`` and graded
+    memory), so it is an independent check of the onset."""
+    common = ["loading.machine_stiffness=300", "loading.v=1e-1", "numerics.rtol=1e-6"]
+    onset = solvers.simulate(load_scene(CONFIGS / "compliant_machine.yaml",
+                                        overrides=common))
+    assert onset.summary["solver"] == "onset_quadrature"
+    run = solvers.simulate(scene_of("compliant_machine", *common))
+    assert run.summary["solver"] == "edge_quadrature"
+    assert run.t_detach == pytest.approx(onset.t_detach, rel=1e-10)
+    assert run.F_total_detach == pytest.approx(onset.F_total_detach, rel=1e-10)
+
+
+def test_a_run_ending_in_a_fold_keeps_the_spring_balanced_on_its_last_row():
+    """300 N/m at 1e-3 m/s: the zone alone turns back in time (a fold). The history's last
+    row is the fold's time with the last node's force and radii; its lift is the one that
+    balances that force (a review found it 3e-5 off, the lift of the radii past the fold)."""
+    res = solvers.simulate(scene_of("compliant_machine", "loading.machine_stiffness=300",
+                                    "numerics.rtol=1e-6"))
+    assert res.summary["solver"] == "edge_quadrature" and not res.notes
+    rows = res.history
+    spring = 300.0 * (1e-3 * rows["t"] - rows["h"])
+    assert np.max(np.abs(spring - rows["F_total"])) <= 1e-12 * np.max(rows["F_total"])
+    assert rows["t"][-1] == res.t_separation > rows["t"][-2]

@@ -811,6 +811,10 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
             if kind[j] >= 0:
                 next_c, next_k = pos[j], kind[j]
                 break
+        if lo == 0.0 and k < 0 and rh[0] != rh[0]:
+            # behind a machine spring the lift path starts like sqrt(s) (the punch catching
+            # up with the driver, machine_lift): graded toward s = 0 with u^2 there
+            prev_c, prev_k = 0.0, 0
         width = hi - lo
         need_l = (lo - prev_c) * 3.0 < width
         need_r = (next_c - hi) * 3.0 < width

@@ -44,13 +44,15 @@ _GX, _GW = 0.5 * (_GAUSS[0] + 1.0), 0.5 * _GAUSS[1]
 class Machine:
     """A pull through a machine spring in the kernels' units: ``kappa``, the lift law
     ``ell = k H + c dH/dt`` and the lift path before the onset (rows: nodes, ``H``, ``ell``
-    on ``sqrt(t / span)``)."""
+    on ``sqrt(t / span)``), with the spring's stiffness [N/m] and the path's estimate."""
 
     kappa: float
     k: float
     c: float
     path: np.ndarray
     span: float
+    stiffness: float  # N/m
+    path_error: float  # the lift path's estimate, relative (machine_lift.machine_pull)
 
     @classmethod
     def from_scene(cls, scene, t_limit: float) -> "Machine":
@@ -58,10 +60,10 @@ class Machine:
         :func:`.machine_lift.machine_pull` finds none)."""
         problem = Problem.from_scene(scene)
         stiffness = scene.loading.machine_stiffness
-        pull, _, _, _ = machine_pull(problem, stiffness, t_limit,
-                                     min(scene.numerics.rtol, 1e-6))
+        pull, _, _, path_error = machine_pull(problem, stiffness, t_limit,
+                                              min(scene.numerics.rtol, 1e-6))
         kappa = stiffness * problem.delta / (2.0 * problem.sigma_c * problem.a ** 2)
-        return cls(kappa, problem.k, problem.c, pull.path, pull.span)
+        return cls(kappa, problem.k, problem.c, pull.path, pull.span, stiffness, path_error)
 
     def law_array(self) -> np.ndarray:
         """The kernels' ``rh`` for ``ell`` before the onset (:func:`kernels.ell_of`)."""

@@ -733,9 +733,11 @@ def history(run: March) -> dict:
         for name in out:
             out[name].append(out[name][-1])
         out["t"][-1] = run.fold[0] * ts
+        # (behind a spring the lift that balances the row's force: the force and radii are
+        # the last node's, the time the fold's)
         out["h"][-1] = (model.h0 + model.v * run.fold[0] * ts if rigid else
-                        model.machine.lift_alone(run.fold[0], run.hist[1, run.n - 1])
-                        * model.delta)
+                        model.v * run.fold[0] * ts - out["F_total"][-1]
+                        / model.machine.stiffness)
     return {name: np.array(values) for name, values in out.items()}
 
 
@@ -860,6 +862,8 @@ class EdgeQuadratureSolver(Solver):
             if fine is None or _handed_over(fine, model, t_limit) or not estimate <= rtol:
                 from .contact import ContactSolver
                 return ContactSolver().solve(scene, observers)
+        if model.machine is not None:  # (both marches share the lift path before the onset)
+            estimate += model.machine.path_error
         return _result(scene, model, fine, estimate, coarse.evaluations + fine.evaluations,
                        observers, time.perf_counter() - wall)
 
