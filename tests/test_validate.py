@@ -11,7 +11,7 @@ from pulloff.cli import main
 @pytest.fixture(scope="module")
 def validation(tmp_path_factory):
     out = tmp_path_factory.mktemp("validation")
-    report = val.validate(out, rtol=1e-4, small=True, workers=2)
+    report = val.validate(out, rtol=1e-4, small=True, workers=1)
     return out, report
 
 
