@@ -81,9 +81,11 @@ def test_load_rejects_foreign_files(tmp_path):
         h5io.load(text)
 
 
-#: Configs whose full run takes tens of seconds (see benchmarks/): here up to their onset.
+#: Configs whose full run takes seconds or more (see benchmarks/): here up to their onset or
+#: at a coarse rtol (this test is of the command and its files).
 SLOW_CONFIGS = {"prony_external.yaml": ["--set", "model.until=detach"],
                 "tip_profile.yaml": ["--set", "numerics.rtol=1e-2"],
+                "sphere_sls_cycle.yaml": ["--set", "numerics.rtol=1e-2"],
                 "sphere_force_control.yaml": ["--set", "numerics.rtol=1e-2"]}
 #: Configs run in full by their own tests (here they would only repeat them).
 RUN_ELSEWHERE = {"sphere_force_control.yaml": "tests/test_paths.py",
