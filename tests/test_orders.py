@@ -67,8 +67,11 @@ SCENES = {
     "separation_kv": ("separation_kv", [], LEVELS),
     "finite_punch_internal": ("finite_punch_internal", [], LEVELS),
     "sls_finite_punch": ("sls_finite_punch", [], LEVELS),
+    # (to n = 64: its errors fall regularly from n = 8, orders 3.0 and 2.7 over n = 8..64;
+    # its n = 128 level costs half the scene's 2.3 s)
     "sls_external_v1e-2": ("sls_finite_punch", ["loading.v=1e-2",
-                                                "geometry.cohesive_zone=external"], LEVELS),
+                                                "geometry.cohesive_zone=external"],
+                           LEVELS[:-1]),
 }
 #: Our summary name -> the reference's.
 OUTPUTS = {"t_detach": "t_onset", "t_separation": "t_separation",
