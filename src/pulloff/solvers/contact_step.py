@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kernels import contact as K
-from . import contact_state as st
 
 
 
@@ -255,7 +254,7 @@ class Step:
         if self.fresh or (alpha is None and not self.s.setup.flat
                           and not self.s.setup.law.maxwell):
             return None
-        s, now, before = self.s, self.now, self.before
+        s, now = self.s, self.now
         nodes, law = s.nodes, s.setup.law
         lift, Hdot, Hf = self._end_of(H_new)
         sc = self._constants_at(H_new, Hdot)

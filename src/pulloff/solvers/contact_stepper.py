@@ -836,7 +836,6 @@ class Stepper:
     # --- committing a step ---------------------------------------------------------------------
     def commit(self, step, ev) -> None:
         """Make the end of ``step`` the new instant: element states, statuses, new elements."""
-        nodes = self.nodes
         t1 = self.now.t + step.dt
         if step.fresh or not self._commit_plain(ev, t1):
             self._commit_elements(step, ev, t1)
