@@ -849,13 +849,8 @@ def local_terms(ctx, rh, cr):
 
 @njit(cache=True)
 def edge_gap(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded):
-    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]."""
-    T = ctx[2]
-    total = local_terms(ctx, rh, cr)
-    if cr.size <= 2 or T <= 0.0:
-        return total
-    return total + history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded,
-                                    memory_start(T, cr), T)
+    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]: all of the memory."""
+    return edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, -math.inf, 1)
 
 
 @njit(cache=True)

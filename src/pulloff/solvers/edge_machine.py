@@ -81,9 +81,9 @@ class Machine:
         ``t_zero`` and then kept its load ``ell_zero``."""
         if self.c == 0.0:
             return lift_zero
-        rest = ell_zero / self.k if self.k > 0.0 else math.nan
         if self.k == 0.0:  # (a viscous solid creeps at a constant rate)
             return lift_zero + ell_zero * (t - t_zero) / self.c
+        rest = ell_zero / self.k
         return rest + (lift_zero - rest) * math.exp(-self.k * (t - t_zero) / self.c)
 
     def receding(self, hist: np.ndarray, lifts: np.ndarray, first: int, i: int) -> tuple:

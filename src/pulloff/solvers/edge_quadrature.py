@@ -202,10 +202,10 @@ class March:
         self.ctx = np.zeros(6)
         self.ctx[1] = self.model.zone
 
-    def node_ell(self, i: int):
-        """The bonded load at node ``i`` behind a machine spring (None: a rigid pull's, a
-        function of time)."""
-        return None if self.machine is None else self.hist[3, i]
+    def node_ell(self, i: int) -> float:
+        """The bonded load at node ``i``: the history's behind a machine spring, a rigid
+        pull's at the node's time."""
+        return self.model.ell(self.hist[0, i]) if self.machine is None else self.hist[3, i]
 
     # -- the gap -----------------------------------------------------------------------------
     def _context(self, t, p, phase, ell=None):
@@ -414,14 +414,10 @@ def _miss(run: March, ph: _Phase, q: float, q_guess: float, t: float) -> float:
     return max(dq, miss_t)
 
 
-def _zone_past_bond(run: March, t: float, p: float, phase: int, a_on2: float,
-                    sigma: float) -> float:
-    """``b^2 - a_onset^2`` at a point of the branch: its sign change is a kink of the
-    openings (see the module)."""
-    if phase == 3:
-        return p - a_on2
-    ell = run.ell_at(t, p, sigma, phase)
-    return 1.0 - p + ell * ell - a_on2
+def _zone_past_bond(p: float, phase: int, ell: float, a_on2: float) -> float:
+    """``b^2 - a_onset^2`` (``ell`` the bonded load there, unused for the zone alone): its
+    sign change is a kink of the openings (see the module)."""
+    return (1.0 - p + ell * ell if phase == 2 else p) - a_on2
 
 
 def _land_on_end(run: March, ph: _Phase, piece: int, sigma: float) -> tuple:
@@ -446,7 +442,8 @@ def _land_on_kink(run: March, ph: _Phase, piece: int, sigma: float, before: floa
     def residual(s):
         q, t = _step(run, ph, s, _predict(run, piece, s, run.qs), piece)
         found[s] = (q, t)
-        return _zone_past_bond(run, t, ph.p(q), ph.phase, a_on2, s)
+        p = ph.p(q)
+        return _zone_past_bond(p, ph.phase, run.ell_at(t, p, s, ph.phase), a_on2)
 
     s = illinois(residual, run.hist[2, run.n - 1], sigma, before, after, 1e-15 * abs(sigma))
     q, t = found[s] if s in found else _step(run, ph, s, _predict(run, piece, s, run.qs),
@@ -550,11 +547,8 @@ def march(run: March) -> None:
         if t > run.t_limit:
             run.end = "t_max"
             return
-        before = (_zone_past_bond(run, run.hist[0, n - 1], run.hist[1, n - 1], ph.phase,
-                                  a_on2, run.hist[2, n - 1])
-                  if run.machine is None or ph.phase == 3 else
-                  1.0 - run.hist[1, n - 1] + run.hist[3, n - 1] ** 2 - a_on2)
-        after = _zone_past_bond(run, t, p, ph.phase, a_on2, sigma)
+        before = _zone_past_bond(run.hist[1, n - 1], ph.phase, run.node_ell(n - 1), a_on2)
+        after = _zone_past_bond(p, ph.phase, run.ell_at(t, p, sigma, ph.phase), a_on2)
         if before > 0.0 and after < 0.0 and not at_end and not crossed:
             q, t, sigma = _land_on_kink(run, ph, piece, sigma, before, after, a_on2)
             run.push(t, ph.p(q), sigma, q)
@@ -571,7 +565,7 @@ def march(run: March) -> None:
             run.end = "collapse"
             return
         run.t_zero = t
-        b0 = (model.ell(t) if run.machine is None else run.hist[3, run.n - 1]) ** 2
+        b0 = run.node_ell(run.n - 1) ** 2
         ph = _Phase(3, b0, 0.0)
         piece, crossed = run.n, False
         if run.machine is not None:
