@@ -623,3 +623,24 @@ def test_property_the_contact_view_is_a_scan_of_every_element(data, n, n_arms):
             want = _scanned_memory(xi, status, D, tj, kappa, tau, t, float(x))
             assert out.tolist() == want.tolist(), (x, t)
             assert got == sum(kappa[i] * want[i] for i in range(n_arms))
+
+
+def test_compiled_horner_is_numpys_bit_for_bit():
+    """The history's cohesive force with the compiled Horner sum (kernels.history.horner, what
+    si_history passes) equals the numpy one bit for bit: thin zones (all of the series), wide
+    ones (series and closed form mixed), short arrays (summed in Python floats), empty ones."""
+    from pulloff.model import analytic
+    from pulloff.solvers.problem import compiled_horner
+
+    rng = np.random.default_rng(11)
+    a = 1e-3
+    for S_max in (1e-8, 1e-3, 0.3, 0.5, 0.7, 3.0, 300.0):
+        for n in (0, 1, 5, 16, 17, 257, 1000):
+            S = S_max * rng.random(n)
+            b = a * np.sqrt(1.0 + S * S)
+            want = analytic.cohesive_force(2e5, a, b)
+            got = analytic.cohesive_force(2e5, a, b, horner=compiled_horner)
+            assert got.tobytes() == want.tobytes(), (S_max, n)
+    x = rng.random((3, 4))
+    coeffs = [0.5, -0.25, 1.0 / 3.0]
+    assert compiled_horner(coeffs, x).tobytes() == analytic._horner(coeffs, x).tobytes()

@@ -620,12 +620,13 @@ _COH_SERIES = [(-1) ** (n + 1) * 2.0 / ((2 * n - 1) * (2 * n + 1)) for n in rang
 _COH_SERIES_MAX_S = 0.5
 
 
-def _cohesive_bracket(S):
-    """``(1 + S^2) atan(S) - S`` for an array ``S >= 0``, to ~1e-15 relative."""
+def _cohesive_bracket(S, horner=_horner):
+    """``(1 + S^2) atan(S) - S`` for an array ``S >= 0``, to ~1e-15 relative (``horner``: see
+    :func:`cohesive_force`)."""
     S = np.asarray(S, dtype=float)
     small = S < _COH_SERIES_MAX_S
     if small.all():  # (a thin zone's whole history: no masks)
-        return _cohesive_series(S)
+        return _cohesive_series(S, horner)
     # math.atan, not np.arctan: numpy's vectorised arctan may round differently in the last
     # bit (it did on an Intel Xeon, not on an AMD EPYC), and a history's row must be the
     # scalar path's value whatever the machine.
@@ -633,15 +634,15 @@ def _cohesive_bracket(S):
     with np.errstate(over="ignore", invalid="ignore"):
         out = (1.0 + S * S) * atan - S
     if small.any():
-        out[small] = _cohesive_series(S[small])
+        out[small] = _cohesive_series(S[small], horner)
     return out
 
 
-def _cohesive_series(S):
+def _cohesive_series(S, horner=_horner):
     """The series below ``S = 0.5``, all its terms (as :func:`_cohesive_force_scalar`, bit
     for bit; a truncation chosen per array made an element depend on its neighbours)."""
     s2 = S * S
-    return S * s2 * _horner(_COH_SERIES, s2)
+    return S * s2 * horner(_COH_SERIES, s2)
 
 
 def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
@@ -657,13 +658,15 @@ def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
     return 2.0 * sigma_c * a * a * bracket
 
 
-def cohesive_force(sigma_c, a, b):
+def cohesive_force(sigma_c, a, b, horner=None):
     """Force of the cohesive annulus ``a < r < b`` alone, in [N] (MODEL.md section 3).
 
     ``sigma_c [pi b^2 - 2 a sqrt(b^2-a^2) - 2 b^2 asin(a/b)] = 2 sigma_c a^2 [(1+S^2) atan S - S]``
     with ``S = sqrt(b^2 - a^2)/a``; inputs sigma_c [Pa], a [m], b [m] (``b >= a``; ``b`` may be an
     array).  For small ``S`` the force is ``~ (4/3) sigma_c a^2 S^3`` and both forms cancel
     catastrophically, so a series is used below ``S = 0.5``; accurate to ~1e-15 relative.
+    ``horner(coeffs, x)`` sums the series over an array ``x`` with the operations of
+    :func:`_horner` (the solvers pass a compiled one; this module stays free of numba).
     """
     a = float(a)
     if np.ndim(b) == 0:
@@ -673,7 +676,7 @@ def cohesive_force(sigma_c, a, b):
         raise ValueError("cohesive_force needs b >= a")
     # (b - a) is exact for b <= 2a (Sterbenz), so S keeps full relative precision for thin zones
     S = np.sqrt((b - a) * (b + a)) / a
-    return _out(2.0 * sigma_c * a * a * _cohesive_bracket(S))
+    return _out(2.0 * sigma_c * a * a * _cohesive_bracket(S, horner or _horner))
 
 
 def predictions(scene) -> dict:

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels import history as history_kernels
 from ..model import analytic
 
 
@@ -115,6 +116,24 @@ def si_history(problem: "Problem", t, gap) -> dict:
         "gap": gap * problem.delta,
         "F_contact": F_contact,
         # (total_force's own sum, without computing b and F_contact again)
-        "F_total": F_contact + analytic.cohesive_force(problem.sigma_c, problem.a, b),
+        "F_total": F_contact + analytic.cohesive_force(problem.sigma_c, problem.a, b,
+                                                       horner=compiled_horner),
         "segment": np.zeros(np.shape(t)),  # a pull is one segment
     }
+
+
+#: Coefficient lists of :func:`compiled_horner` as arrays, by ``id`` (with the list itself, so
+#: that an id is never reused for another list while it is here).
+_COEFFICIENT_ARRAYS: dict = {}
+
+
+def compiled_horner(coeffs, x) -> np.ndarray:
+    """:func:`pulloff.model.analytic._horner` compiled (:func:`pulloff.kernels.history.horner`:
+    the same operations, so the same bits): ``sum_j coeffs[j] x^j`` for an array ``x``."""
+    entry = _COEFFICIENT_ARRAYS.get(id(coeffs))
+    if entry is None or entry[0] is not coeffs:
+        entry = _COEFFICIENT_ARRAYS[id(coeffs)] = (coeffs, np.array(coeffs, dtype=float))
+    x = np.ascontiguousarray(x, dtype=float)
+    out = np.empty(x.shape)
+    history_kernels.horner(entry[1], x.reshape(-1), out.reshape(-1))
+    return out
