@@ -612,12 +612,12 @@ def assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order
                "solver": solver, "history": scene.model.history, "until": scene.model.until,
                "cohesive_zone": scene.geometry.cohesive_zone, **problem.groups}
     if detached:
+        F_contact, F_total = problem.forces(td)
         summary.update(
             t_detach=td * T, h_detach=float(problem.lift(td)),
             b_detach=float(problem.zone_end(td)),
             zone_ratio_detach=float(zone_ratio(problem.s_of(td))),
-            F_contact_detach=float(problem.contact_force(td)),
-            F_total_detach=float(problem.total_force(td)))
+            F_contact_detach=float(F_contact), F_total_detach=float(F_total))
     summary.update(extra or {})
     snapshots = [(ts * T, problem.a * np.sqrt(1.0 + sig * sig), problem.delta * U)
                  for ts, sig, U in run.snapshots]

@@ -99,8 +99,14 @@ class Problem:
 
     def total_force(self, t):
         """``F_contact`` plus the cohesive zone's own force [N] (MODEL.md section 3)."""
-        return self.contact_force(t) + analytic.cohesive_force(self.sigma_c, self.a,
-                                                               self.zone_end(t))
+        return self.forces(t)[1]
+
+    def forces(self, t):
+        """``(F_contact, F_total)`` [N] at dimensionless time ``t``: the contact force computed
+        once for both (an onset run wants both at three times)."""
+        F_contact = self.contact_force(t)
+        return F_contact, F_contact + analytic.cohesive_force(self.sigma_c, self.a,
+                                                              self.zone_end(t))
 
 
 def si_history(problem: "Problem", t, gap) -> dict:
