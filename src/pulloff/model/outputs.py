@@ -8,6 +8,7 @@ is ``nan`` (or empty text) in its result, never missing.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 #: Which scenes have a quantity (the ``where`` of :class:`Quantity`), as a user reads it.
@@ -155,6 +156,23 @@ BY_NAME = {q.name: q for q in OUTPUTS}
 def of_group(group: str) -> tuple[Quantity, ...]:
     # (once per group: every result is built from these, ~70 quantities a call)
     return tuple(q for q in OUTPUTS if q.group == group)
+
+
+@functools.lru_cache(maxsize=None)
+def names(group: str) -> tuple[str, ...]:
+    """The names of one group, in declaration order."""
+    return tuple(q.name for q in of_group(group))
+
+
+@functools.lru_cache(maxsize=None)
+def _missing(group: str) -> dict:
+    return {q.name: "" if q.text else math.nan for q in of_group(group)}
+
+
+def missing(group: str) -> dict:
+    """``name -> value`` of a quantity a scene does not have (nan, or empty text), for one
+    group in declaration order (a new dict: a result fills in its own values)."""
+    return dict(_missing(group))
 
 
 def units(group: str) -> dict[str, str]:

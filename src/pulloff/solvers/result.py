@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,18 +32,18 @@ class Result:
     def build(cls, summary: dict, analytic: dict, history: dict, **rest) -> "Result":
         """A result from the values a solver has; every other declared quantity is filled
         with nan (numbers) or empty text, so no consumer ever meets a missing key."""
-        full = {}
-        for q in outputs.of_group("summary"):
-            full[q.name] = summary.get(q.name, "" if q.text else math.nan)
-        unknown = set(summary) - set(full)
+        # (from tables made once: building them per result was ~5 us of a 0.3 ms run)
+        full = outputs.missing("summary")
+        unknown = summary.keys() - full.keys()
         if unknown:
             raise KeyError(f"summary quantities not in the output table: {sorted(unknown)}")
-        an = {q.name: analytic.get(q.name, "" if q.text else math.nan)
-              for q in outputs.of_group("analytic")}
+        full.update(summary)  # (in the table's order: every key is already there)
+        missing = outputs.missing("analytic")
+        an = {name: analytic.get(name, value) for name, value in missing.items()}
         # A pull has one segment: its history may leave that column out.
         history = dict(history)
         history.setdefault("segment", np.zeros(np.shape(history["t"])))
-        hist = {name: np.asarray(history[name], dtype=float) for name in outputs.units("history")}
+        hist = {name: np.asarray(history[name], dtype=float) for name in outputs.names("history")}
         if not full["notes"]:
             full["notes"] = "; ".join(rest.get("notes", ()))
         return cls(full, an, hist, **rest)
