@@ -599,10 +599,11 @@ def assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order
     if detached and run.t_detach > 0.0:
         # Keep the rows before detachment and end the history exactly at the event.
         keep = t_hist < run.t_detach
-        t_hist = np.append(t_hist[keep], run.t_detach)
-        gap_hist = np.append(gap_hist[keep], 1.0)
-    if observers.every is None or streamed:
-        # (A fixed-step run's full history is streamed; this is its preview.)
+        t_hist = np.concatenate((t_hist[keep], (run.t_detach,)))
+        gap_hist = np.concatenate((gap_hist[keep], (1.0,)))
+    if (observers.every is None or streamed) and t_hist.size > observers.history_rows:
+        # (A fixed-step run's full history is streamed; this is its preview. Rows within
+        # the limit are all kept: decimate's indices would be every row.)
         rows = decimate(t_hist.size, observers.history_rows)
         t_hist, gap_hist = t_hist[rows], gap_hist[rows]
     td = run.t_detach

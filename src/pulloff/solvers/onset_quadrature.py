@@ -64,6 +64,7 @@ def _rule(m: int):
     return graded, 0.5 * (x + 1.0), 0.5 * w
 
 
+@functools.lru_cache(maxsize=64)
 def first_rule(rtol: float) -> int:
     """The cheapest rule expected to be :data:`_RULE_MARGIN` within ``rtol`` (the last but
     one at most: the last checks it)."""
