@@ -20,7 +20,7 @@ stepper (:mod:`pulloff.kernels.onset`) marches every element of the zone instead
 methods solve the same model, and the reference (:mod:`pulloff.references.onset`) integrates
 over the elements first, adaptively.
 
-**A moving edge** (the second part, :func:`edge_gap`): the same swap for a flat punch whose
+**A moving edge** (the second part, :func:`edge_gap_split`): the same swap for a flat punch whose
 bond radius ``a`` and zone end ``b`` both move, under any rheology with a creep compliance
 ``J(t) = J(0) + int J'`` of exponentials. See :mod:`pulloff.solvers.edge_quadrature`.
 
@@ -679,11 +679,13 @@ def _graded_toward(lo, hi, k, c, toward_hi, m_graded, sq_end, ctx, rh, cr, hist,
             d1 = near
         sq = last and sq_end and near == 0.0
         if toward_hi:
-            tot += _history_panel(c - d0, c - d1, k, False, sq, ctx, rh, cr, hist, n, segs, deg, gx,
-                          gw, w, dw)
+            # (flags passed as variables, False here: constants would compile the panel
+            # again for each literal value)
+            tot += _history_panel(c - d0, c - d1, k, not toward_hi, sq, ctx, rh, cr, hist, n,
+                                  segs, deg, gx, gw, w, dw)
         else:
-            tot += _history_panel(c + d1, c + d0, k, sq, False, ctx, rh, cr, hist, n, segs, deg, gx,
-                          gw, w, dw)
+            tot += _history_panel(c + d1, c + d0, k, sq, toward_hi, ctx, rh, cr, hist, n, segs,
+                                  deg, gx, gw, w, dw)
         if last:
             break
         d0 = d1
@@ -820,13 +822,13 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
         need_r = (next_c - hi) * 3.0 < width
         mid = 0.5 * (lo + hi) if need_l and need_r else (hi if need_l else lo)
         if need_l:
-            acc += _graded_toward(lo, mid, k, prev_c, False, n_graded, prev_k == 0, ctx, rh,
+            acc += _graded_toward(lo, mid, k, prev_c, not need_l, n_graded, prev_k == 0, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
         if need_r:
-            acc += _graded_toward(mid, hi, k, next_c, True, n_graded, next_k == 0, ctx, rh,
+            acc += _graded_toward(mid, hi, k, next_c, need_r, n_graded, next_k == 0, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
         if not (need_l or need_r):
-            acc += _history_panel(lo, hi, k, False, False, ctx, rh, cr, hist, n, segs, deg,
+            acc += _history_panel(lo, hi, k, need_l, need_r, ctx, rh, cr, hist, n, segs, deg,
                                   gx, gw, w, dw)
     return acc
 
@@ -848,14 +850,11 @@ def local_terms(ctx, rh, cr):
 
 
 @njit(cache=True)
-def edge_gap(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded):
-    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]: all of the memory."""
-    return edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, -math.inf, 1)
-
-
-@njit(cache=True)
 def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part):
-    """part 0: the memory before s_split; 1: the rest (with the local terms)."""
+    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]. part 0: the memory before
+    s_split; 1: the rest (with the local terms); all of it: part 1 from ``-inf``. (One entry
+    point: numba optimises each with its callees, so a second one for the whole memory cost
+    ~1.5 s more of a first compile.)"""
     T = ctx[2]
     s0 = memory_start(T, cr)
     if part == 0:

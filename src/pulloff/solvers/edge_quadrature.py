@@ -1,8 +1,8 @@
 """A flat punch pulled to separation by quadrature over its history: no foundation mesh.
 
 Elements do not interact, so the gap at the zone end is one integral over the history of the
-two radii (:func:`pulloff.kernels.quadrature.edge_gap`: the spatial part in closed form). The
-history is what is solved for:
+two radii (:func:`pulloff.kernels.quadrature.edge_gap_split`: the spatial part in closed
+form). The history is what is solved for:
 
 - **onset** (``a`` pinned at ``R`` with the zone outside, or ``b`` pinned at ``R`` with the
   zone on the face): explicit, the onset is the root of ``gap = delta`` in time;
@@ -245,9 +245,9 @@ class March:
 
     def onset_gap(self, t: float) -> float:
         self.evaluations += 1
-        return kernels.edge_gap(self._context(t, 0.0, 1), self.model.rh, self.model.cr,
-                                self.hist, 0, self.segs, DEGREE, self.gx, self.gw,
-                                self.graded)
+        return kernels.edge_gap_split(self._context(t, 0.0, 1), self.model.rh,
+                                      self.model.cr, self.hist, 0, self.segs, DEGREE, self.gx,
+                                      self.gw, self.graded, -math.inf, 1)
 
     def _trial(self, t, p, sigma, phase):
         """The history with a trial node after the accepted ones: ``(hist, n)``. A trial
@@ -290,7 +290,7 @@ class March:
             # the punch moves with the zone; the virtual element crept (edge_machine)
             alone = self.trial_lift - self.machine.virtual_lift(t, *self.zero)
         if part < 0:
-            return kernels.edge_gap(*args) + alone
+            split, part = -math.inf, 1
         return kernels.edge_gap_split(*args, split, part) + alone
 
     def push(self, t, p, sigma, q, new_piece=None):
