@@ -38,11 +38,14 @@ SCENES = {
     "separation_elastic": ("separation_elastic", []),
     "separation_kv_v1e-2": ("separation_kv", ["loading.v=1e-2"]),
     "sls_finite_punch_v1e-4": ("sls_finite_punch", ["loading.v=1e-4"]),
-    # (handed to the stepper until the twentieth session: the first snaps at a fold of its
-    # bond, the second's march turned back falsely; see the tests below)
+    # (handed to the stepper until the twentieth session, its march turning back falsely;
+    # see the tests below)
+    "sls_finite_punch_v1e-7": ("sls_finite_punch", ["loading.v=1e-7"]),
+}
+#: Scenes whose branch turns back while the bond holds (handed to the stepper).
+BOND_FOLDS = {
     "sls_external_v1e-2": ("sls_finite_punch", ["loading.v=1e-2",
                                                 "geometry.cohesive_zone=external"]),
-    "sls_finite_punch_v1e-7": ("sls_finite_punch", ["loading.v=1e-7"]),
 }
 #: Our summary name -> the reference's.
 OUTPUTS = {"t_detach": "t_onset", "F_total_detach": "F_onset_total",
@@ -51,7 +54,7 @@ OUTPUTS = {"t_detach": "t_onset", "F_total_detach": "F_onset_total",
 
 
 def scene_of(name, *extra):
-    config, overrides = SCENES[name]
+    config, overrides = {**SCENES, **BOND_FOLDS}[name]
     return load_scene(CONFIGS / f"{config}.yaml",
                       overrides=["model.until=separation", *overrides, *extra])
 
@@ -170,15 +173,19 @@ def test_pulls_to_separation_are_routed_here_steps_and_other_springs_elsewhere()
         "onset_quadrature"
 
 
-def test_a_fold_while_the_bond_holds_is_a_snap_off(results):
-    """A standard linear solid pulled at 1e-2 m/s with its zone outside: its branch turns back
-    34 us after the onset with the bond still holding (a > 0), where the reference finds a
-    fold too (and the stepper its separation). Under a rigid pull that is the snap-off."""
-    run = edge.run_at(edge.EdgeModel.from_scene(scene_of("sls_external_v1e-2")), 8e-4,
-                      math.inf)
-    assert run.end == "fold" and math.isnan(run.t_zero)
-    assert REFERENCE["sls_external_v1e-2"]["separation_kind"] == "fold"
-    assert results["sls_external_v1e-2"].summary["solver"] == "edge_quadrature"
+@pytest.mark.parametrize("name,tol", [("sls_external_v1e-2", 8e-4),
+                                      ("sls_finite_punch_v1e-7", 2e-8)])
+def test_a_branch_turning_back_while_the_bond_holds_goes_to_the_stepper(name, tol):
+    """A standard linear solid at 1e-2 m/s with the zone outside snaps 34 us after its onset
+    (the reference's fold, a real one); at 1e-7 m/s on the face, at a tolerance near the
+    gap's rounding, the march turns back 1e-3 creep times after the onset, 1.3 s before the
+    reference's separation (a false fold, and the march at tolerance 5e-9 turns back at the
+    same place). A march cannot tell them apart: both hand the scene to the contact solver
+    (checked by the march's ending: that solver takes seconds here)."""
+    model = edge.EdgeModel.from_scene(scene_of(name))
+    run = edge.run_at(model, tol, math.inf)
+    assert run.end == "bond_fold" and math.isnan(run.t_zero)
+    assert edge._handed_over(run, model, math.inf)
 
 
 @pytest.mark.parametrize("tol", [8e-4, 8e-5, 8e-6])
