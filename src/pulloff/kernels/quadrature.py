@@ -825,10 +825,37 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
 
 
 @njit(cache=True)
-def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_hi):
+def _interval_from_states(k, states, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw):
+    """:func:`_history_panel` over the whole history interval ``k``, bit for bit, from its
+    Gauss points' ``(s, weight, ell, r, P)``, kept in ``states[k]`` (``states[k, 0]``: 1 once
+    filled) the first time: an interval whose stencil holds no trial node is the same at
+    every later step, so only the memory's kernel and the opening against the zone end are
+    left to evaluate (the state's interpolation was ~45 % of a point's cost)."""
+    row = states[k]
+    if row[0] == 0.0:
+        i0, m, phase = _stencil(k, n, segs, deg)
+        a = hist[2, k]
+        width = hist[2, k + 1] - a
+        for i in range(gx.size):
+            s, ds, ell, r, P = _state_sigma(a + width * gx[i], phase, hist, i0, m, w, dw, rh)
+            j = 1 + 5 * i
+            row[j], row[j + 1], row[j + 2], row[j + 3], row[j + 4] = s, gw[i] * ds, ell, r, P
+        row[0] = 1.0
+    T, ell_T, r_T, P_T = ctx[2], ctx[3], ctx[4], ctx[5]
+    tot = 0.0
+    for i in range(gx.size):
+        j = 1 + 5 * i
+        tot += row[j + 1] * creep_rate(T - row[j], cr) * opening(row[j + 2], row[j + 3],
+                                                                 row[j + 4], ell_T, r_T, P_T)
+    return tot * (hist[2, k + 1] - hist[2, k])
+
+
+@njit(cache=True)
+def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_hi, states):
     """``int_{s_lo}^{s_hi} J'(T - s) opening(s, T) ds`` (``s_hi <= T``): Gauss panels between
     the history's nodes, graded geometrically toward every singular point closer than three
-    panel widths (:func:`_singular_points`), with ``u^2`` at a square root."""
+    panel widths (:func:`_singular_points`), with ``u^2`` at a square root; whole intervals
+    whose stencil is final from ``states`` (:func:`_interval_from_states`)."""
     w = np.empty(deg + 1)
     dw = np.empty(deg + 1)
     pos, kidx, kind = _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_lo)
@@ -866,7 +893,13 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
         elif need_r:
             acc += _graded_toward(mid, hi, k, next_c, need_r, n_graded, next_k == 0, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
-        if not (need_l or need_r):
+        if need_l or need_r:
+            continue
+        if (0 <= k < states.shape[0] and k + deg + 2 < n and lo == hist[0, k]
+                and hi == hist[0, k + 1]):
+            acc += _interval_from_states(k, states, ctx, rh, cr, hist, n, segs, deg, gx, gw,
+                                         w, dw)
+        else:
             acc += _history_panel(lo, hi, k, k - k, ctx, rh, cr, hist, n, segs, deg, gx, gw,
                                   w, dw)  # (k - k: 0, not a constant)
     return acc
@@ -889,22 +922,24 @@ def local_terms(ctx, rh, cr):
 
 
 @njit(cache=True)
-def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part):
+def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part, states):
     """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]. part 0: the memory before
-    s_split; 1: the rest (with the local terms); all of it: part 1 from ``-inf``. (One entry
-    point: numba optimises each with its callees, so a second one for the whole memory cost
-    ~1.5 s more of a first compile.)"""
+    s_split; 1: the rest (with the local terms); all of it: part 1 from ``-inf``. ``states``:
+    the history's intervals' Gauss states, rows of ``1 + 5 gx.size`` (:func:`history_integral`).
+    (One entry point: numba optimises each with its callees, so a second one for the whole
+    memory cost ~1.5 s more of a first compile.)"""
     T = ctx[2]
     s0 = memory_start(T, cr)
     if part == 0:
         if cr.size <= 2 or T <= 0.0 or s_split <= s0:
             return 0.0
-        return history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s0, s_split)
+        return history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s0, s_split,
+                                states)
     total = local_terms(ctx, rh, cr)
     if cr.size <= 2 or T <= 0.0:
         return total
     return total + history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded,
-                                    max(s0, s_split), T)
+                                    max(s0, s_split), T, states)
 
 
 # --- the lift behind a machine spring while the bond recedes (solvers.edge_machine) -------------

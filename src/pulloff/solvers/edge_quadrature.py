@@ -224,6 +224,8 @@ class March:
         self.segs = np.zeros((0, 2), dtype=np.int64)
         self.ctx = np.zeros(6)
         self.ctx[1] = self.model.zone
+        # the history's intervals' Gauss states (kernels.history_integral), grown with it
+        self.states = np.zeros((256, 1 + 5 * self.gx.size))
 
     def sigma_of(self, t: float, q: float) -> float:
         """The march's parameter at time ``t`` and progress ``q``: ``t / t_onset + q``, or
@@ -255,7 +257,7 @@ class March:
         self.evaluations += 1
         return kernels.edge_gap_split(self._context(t, 0.0, 1), self.model.rh,
                                       self.model.cr, self.hist, 0, self.segs, DEGREE, self.gx,
-                                      self.gw, self.graded, -math.inf, 1)
+                                      self.gw, self.graded, -math.inf, 1, self.states)
 
     def _trial(self, t, p, sigma, phase):
         """The history with a trial node after the accepted ones: ``(hist, n)``. A trial
@@ -299,7 +301,7 @@ class March:
             alone = self.trial_lift - self.machine.virtual_lift(t, *self.zero)
         if part < 0:
             split, part = -math.inf, 1
-        return kernels.edge_gap_split(*args, split, part) + alone
+        return kernels.edge_gap_split(*args, split, part, self.states) + alone
 
     def push(self, t, p, sigma, q, new_piece=None):
         """A node; behind a machine spring with its bonded load and lift (a piece's first
@@ -310,6 +312,10 @@ class March:
         if new_piece is not None:
             self.segs = np.vstack([self.segs, [[i, new_piece]]]).astype(np.int64)
         self.hist[:3, i] = t, p, sigma
+        if i == 0:  # (a history begun again: see _unstable_onset)
+            self.states[:, 0] = 0.0
+        elif i >= self.states.shape[0]:
+            self.states = np.concatenate([self.states, np.zeros_like(self.states)])
         if self.machine is not None:
             if new_piece is None:
                 self.hist[3, i], self.lifts[i] = self._lift(self.hist, i, self.segs[-1, 1])
