@@ -82,10 +82,6 @@ def scenes():
     # growing faster than linearly, and its timing decides the separation.
     out["sls_finite_punch_v1e-7"] = dict(out["sls_finite_punch"], v=1e-7)
     out["sls_external_v1e-2"] = dict(out["sls_finite_punch"], zone="external", v=1e-2)
-    # A Kelvin-Voigt face pulled 2e5 creep times to its onset: the edge quadrature's march
-    # turned back there until its time unit and first step were set by the creep time
-    # (twentieth session), and the stepper took 11 minutes.
-    out["finite_punch_internal_v1e-7"] = dict(out["finite_punch_internal"], v=1e-7)
     # A Kelvin-Voigt face whose strength limits the bond (chi_R = 0.94), behind 1 kN/m.
     out["finite_punch_spring_kv"] = dict(G_inf=1e6, eta=1e3, arms=(), sigma_c=1e6, delta=3e-6,
                                          R=1e-5, v=1e-3, h0=0.0, zone="internal",
