@@ -165,14 +165,14 @@ STEPPER_K01 = {"t_separation": 14.343973518452195, "F_peak_total": 0.00143339867
                "estimate": 2.634552222224394e-06}
 
 
-@pytest.mark.parametrize("tol", [8e-4, 8e-5, 8e-6])
+@pytest.mark.parametrize("tol", [8e-4, 8e-5])
 def test_behind_a_tenth_of_a_newton_per_metre_the_bond_runs_through_and_snaps(tol):
     """Behind 0.1 N/m the onset comes 14.3 s (4e4 creep times) into the pull, the crack then
     runs for 9.3 ms and the punch snaps where a reaches 0. With the onset time as its time
     unit the march turned back near the onset at every tolerance (the slow standard linear
     solid's false fold: edge._CREEP_TIMES) and the stepper answered, in 7-11 s. Measured
-    since: 1.7e-7, 2.0e-7, 2.3e-7 off the stepper's separation time and peak force at these
-    tolerances, within the stepper's own estimate."""
+    since: 1.7e-7, 2.0e-7 off the stepper's separation time and peak force at these
+    tolerances (2.3e-7 at 8e-6), within the stepper's own estimate."""
     scene = load_scene(CONFIGS / "compliant_machine.yaml", overrides=[
         "model.until=separation", "loading.machine_stiffness=0.1"])
     run = edge.run_at(edge.EdgeModel.from_scene(scene), tol, math.inf)
