@@ -204,7 +204,6 @@ class March:
     t_unit: float = math.nan  # the time unit of sigma, and its origin (see sigma_of)
     t_origin: float = 0.0
     first_step: float = _FIRST_STEP
-    slopes: list = field(default_factory=lambda: [0.0])  # the last step's residual's, in q
     t_zero: float = math.nan  # when a reached 0
     end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
@@ -332,21 +331,15 @@ class _Steps(Exception):
     """The step cap was reached."""
 
 
-def secant(f, x0: float, h: float, xtol: float = 1e-14, slopes=None) -> float:
+def secant(f, x0: float, h: float, xtol: float = 1e-14) -> float:
     """A root of ``f`` near ``x0`` by secants (first step ``h``), to ``xtol`` relative to
-    ``max(|x|, 1)``. ``slopes``: a one-element list holding a slope of ``f`` to take the
-    first step from instead (a Newton step, when it moves less than ``1e3 h``), and given
-    the last secant's slope back."""
+    ``max(|x|, 1)``."""
     f0 = f(x0)
     x1 = x0 + h
-    if slopes is not None and slopes[0] != 0.0 and abs(f0 / slopes[0]) < 1e3 * abs(h):
-        x1 = x0 - f0 / slopes[0]
     f1 = f(x1)
     for _ in range(40):
         if f1 == f0 or f1 == 0.0:
             break
-        if slopes is not None:
-            slopes[0] = (f1 - f0) / (x1 - x0)
         x0, x1, f0 = x1, x1 - f1 * (x1 - x0) / (f1 - f0), f1
         if abs(x1 - x0) <= xtol * max(abs(x1), 1.0):
             break
@@ -436,7 +429,7 @@ def _step(run: March, ph: _Phase, sigma: float, q_guess: float, piece: int) -> t
             return (run.gap(t_of(q), ph.p(q), ph.phase, sigma, 1, split) + old
                     + (q - q0) * slope - 1.0)
 
-        q = secant(residual, q_guess, h * 10.0, slopes=run.slopes)
+        q = secant(residual, q_guess, h * 10.0)
         # the linearisation's error, ~ (q - q_guess)^2, far below the step's tolerance
         if (q - q_guess) ** 2 <= 1e-3 * run.tol * max(abs(q), 1e-2):
             break
