@@ -239,7 +239,7 @@ class March:
 
     def rounding(self, sigma: float) -> float:
         """The scale of ``sigma``'s rounding: its own, or the onset time's in sigma."""
-        return max(abs(sigma), (self.t_on - self.t_origin) / self.t_unit)
+        return max(abs(sigma), self.t_on / self.t_unit)
 
     def node_ell(self, i: int) -> float:
         """The bonded load at node ``i``: the history's behind a machine spring, a rigid
@@ -845,9 +845,10 @@ def _handed_over(run: March, model: EdgeModel, t_limit: float) -> bool:
     branch. A fold of the bond can be real (a standard linear solid pulled at 1e-2 m/s with
     its zone outside snaps 34 us after its onset, as the reference finds) or false: slow
     pulls turned back near their onset at every tolerance until the march's time unit was
-    capped (:data:`_CREEP_TIMES`), and still do at tolerances near 1e-8, where the steps
-    after the onset come down to the gap's rounding (a standard linear solid at 1e-7 m/s,
-    rtol 1e-8: two marches agreed on such a fold 1.3 s before the separation)."""
+    capped (:data:`_CREEP_TIMES`), and at tolerances near 1e-8 until the step floor was
+    measured against the onset time in that unit (:meth:`March.rounding`; a standard linear
+    solid at 1e-7 m/s, rtol 1e-8: two marches had agreed on a fold 1.3 s before the
+    separation). The march cannot tell a false fold from a real one."""
     return (run.end == "no_onset" and strength_time(model, t_limit) < t_limit
             or run.end in ("bond_fold", "lost"))
 
