@@ -709,19 +709,15 @@ def _graded_toward(lo, hi, k, c, toward_hi, m_graded, sq_end, ctx, rh, cr, hist,
 
 
 @njit(cache=True)
-def _toward_log(lo, hi, toward_hi, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw, k):
+def _toward_log(lo, hi, k, toward_hi, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw):
     """[lo, hi] with a logarithmic point at its high (low) end: Gauss on the half away from
     it, ``u^LOG_POWER`` on the half next to it (see :data:`LOG_POWER`)."""
     mid = 0.5 * (lo + hi)
     sub = LOG_POWER if toward_hi else -LOG_POWER
     plain = sub - sub  # (0, not a constant: see _graded_toward)
-    if toward_hi:
-        return (_history_panel(lo, mid, k, plain, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
-                               dw)
-                + _history_panel(mid, hi, k, sub, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
-                                 dw))
-    return (_history_panel(lo, mid, k, sub, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw)
-            + _history_panel(mid, hi, k, plain, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
+    sub_lo, sub_hi = (plain, sub) if toward_hi else (sub, plain)
+    return (_history_panel(lo, mid, k, sub_lo, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw)
+            + _history_panel(mid, hi, k, sub_hi, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
                              dw))
 
 
@@ -882,14 +878,14 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
         need_r = (next_c - hi) * 3.0 < width
         mid = 0.5 * (lo + hi) if need_l and need_r else (hi if need_l else lo)
         if need_l and prev_k == 1 and prev_c == lo and gx.size >= LOG_RULE_POINTS:
-            acc += _toward_log(lo, mid, not need_l, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
-                               dw, k)
+            acc += _toward_log(lo, mid, k, not need_l, ctx, rh, cr, hist, n, segs, deg, gx, gw,
+                               w, dw)
         elif need_l:
             acc += _graded_toward(lo, mid, k, prev_c, not need_l, n_graded, prev_k == 0, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
         if need_r and next_k == 1 and next_c == hi and gx.size >= LOG_RULE_POINTS:
-            acc += _toward_log(mid, hi, need_r, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw,
-                               k)
+            acc += _toward_log(mid, hi, k, need_r, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
+                               dw)
         elif need_r:
             acc += _graded_toward(mid, hi, k, next_c, need_r, n_graded, next_k == 0, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
