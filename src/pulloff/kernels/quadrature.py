@@ -821,33 +821,57 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
 
 
 @njit(cache=True)
-def _interval_from_states(k, states, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw):
-    """:func:`_history_panel` over the whole history interval ``k``, bit for bit, from its
-    Gauss points' ``(s, weight, ell, r, P)``, kept in ``states[k]`` (``states[k, 0]``: 1 once
-    filled) the first time: an interval whose stencil holds no trial node is the same at
-    every later step, so only the memory's kernel and the opening against the zone end are
-    left to evaluate (the state's interpolation was ~45 % of a point's cost)."""
+def _interval_from_states(k, states, rule, rules, ctx, rh, cr, hist, n, segs, deg, w, dw):
+    """:func:`_history_panel` over the whole history interval ``k`` by the Gauss rule
+    ``rules[rule]`` (``[points, column, distance, width, x..., weights...]`` on [0, 1]), from its
+    points' ``(s, weight, ell, r, P)``, kept in ``states[k]`` from the rule's column on (its
+    first entry 1 once filled) the first time: an interval whose stencil holds no trial node is
+    the same at every later step, so only the memory's kernel and the opening against the
+    zone end are left to evaluate (the state's interpolation was ~45 % of a point's cost)."""
     row = states[k]
-    if row[0] == 0.0:
+    points, col = int(rules[rule, 0]), int(rules[rule, 1])
+    if row[col] == 0.0:
         i0, m, phase = _stencil(k, n, segs, deg)
         a = hist[2, k]
         width = hist[2, k + 1] - a
-        for i in range(gx.size):
-            s, ds, ell, r, P = _state_sigma(a + width * gx[i], phase, hist, i0, m, w, dw, rh)
-            j = 1 + 5 * i
-            row[j], row[j + 1], row[j + 2], row[j + 3], row[j + 4] = s, gw[i] * ds, ell, r, P
-        row[0] = 1.0
+        for i in range(points):
+            s, ds, ell, r, P = _state_sigma(a + width * rules[rule, 4 + i], phase, hist, i0, m,
+                                            w, dw, rh)
+            j = col + 1 + 5 * i
+            row[j], row[j + 1], row[j + 2] = s, rules[rule, 4 + points + i] * ds, ell
+            row[j + 3], row[j + 4] = r, P
+        row[col] = 1.0
     T, ell_T, r_T, P_T = ctx[2], ctx[3], ctx[4], ctx[5]
     tot = 0.0
-    for i in range(gx.size):
-        j = 1 + 5 * i
+    for i in range(points):
+        j = col + 1 + 5 * i
         tot += row[j + 1] * creep_rate(T - row[j], cr) * opening(row[j + 2], row[j + 3],
                                                                  row[j + 4], ell_T, r_T, P_T)
     return tot * (hist[2, k + 1] - hist[2, k])
 
 
 @njit(cache=True)
-def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_hi, states):
+def _rule_at(lo, hi, prev_c, next_c, k, n, segs, hist, rules):
+    """The smallest of ``rules`` (by points, the last the finest) that integrates the whole
+    history interval ``k`` = ``[lo, hi]``: its nearest singular point (``prev_c``,
+    ``next_c``, and the end of its piece, where ``a`` may reach 0: a square root of
+    ``1 - r``) at least ``rules[:, 2]`` widths away, its width at most ``rules[:, 3]`` (the
+    kernel's and the bonded load's exponentials)."""
+    i = segs.shape[0] - 1
+    while segs[i, 0] > k:
+        i -= 1
+    end = segs[i + 1, 0] - 1 if i + 1 < segs.shape[0] and segs[i + 1, 0] < n else n - 1
+    width = hi - lo
+    distance = min(lo - prev_c, next_c - hi, hist[0, end] - hi) / width
+    for j in range(rules.shape[0] - 1):
+        if distance >= rules[j, 2] and width <= rules[j, 3]:
+            return j
+    return rules.shape[0] - 1
+
+
+@njit(cache=True)
+def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_hi, states,
+                     rules):
     """``int_{s_lo}^{s_hi} J'(T - s) opening(s, T) ds`` (``s_hi <= T``): Gauss panels between
     the history's nodes, graded geometrically toward every singular point closer than three
     panel widths (:func:`_singular_points`), with ``u^2`` at a square root; whole intervals
@@ -893,8 +917,9 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
             continue
         if (0 <= k < states.shape[0] and k + deg + 2 < n and lo == hist[0, k]
                 and hi == hist[0, k + 1]):
-            acc += _interval_from_states(k, states, ctx, rh, cr, hist, n, segs, deg, gx, gw,
-                                         w, dw)
+            rule = _rule_at(lo, hi, prev_c, next_c, k, n, segs, hist, rules)
+            acc += _interval_from_states(k, states, rule, rules, ctx, rh, cr, hist, n, segs,
+                                         deg, w, dw)
         else:
             acc += _history_panel(lo, hi, k, k - k, ctx, rh, cr, hist, n, segs, deg, gx, gw,
                                   w, dw)  # (k - k: 0, not a constant)
@@ -918,7 +943,8 @@ def local_terms(ctx, rh, cr):
 
 
 @njit(cache=True)
-def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part, states):
+def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part, states,
+                   rules):
     """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]. part 0: the memory before
     s_split; 1: the rest (with the local terms); all of it: part 1 from ``-inf``. ``states``:
     the history's intervals' Gauss states, rows of ``1 + 5 gx.size`` (:func:`history_integral`).
@@ -930,12 +956,12 @@ def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, p
         if cr.size <= 2 or T <= 0.0 or s_split <= s0:
             return 0.0
         return history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s0, s_split,
-                                states)
+                                states, rules)
     total = local_terms(ctx, rh, cr)
     if cr.size <= 2 or T <= 0.0:
         return total
     return total + history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded,
-                                    max(s0, s_split), T, states)
+                                    max(s0, s_split), T, states, rules)
 
 
 # --- the lift behind a machine spring while the bond recedes (solvers.edge_machine) -------------

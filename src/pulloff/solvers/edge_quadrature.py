@@ -95,6 +95,43 @@ def _rule(tol: float):
     return 0.5 * (x + 1.0), 0.5 * w, graded
 
 
+#: The smaller Gauss rules of a history interval far from every singular point of its
+#: integrand (:func:`kernels._rule_at`), and the errors each is chosen for. An ``n``-point
+#: rule's error on a function analytic inside the Bernstein ellipse ``rho`` is ~``rho^-2n``
+#: (a constant apart: :data:`_FAR_ERROR`), and a singular point ``d`` interval widths away
+#: leaves ``rho = x + sqrt(x^2 - 1)``, ``x = 1 + 2 d``; on ``exp(beta u)`` over [0, 1] it is
+#: ``2^(2n+1) (n!)^4 / ((2n+1) ((2n)!)^3) (beta / 2)^(2n)`` of the integral (:data:`_FAR_EXP_ERROR`).
+_FAR_POINTS = (3, 4, 5, 6, 8)
+_FAR_ERROR = 1e-20
+_FAR_EXP_ERROR = 1e-17
+
+
+def _rule_table(gx: np.ndarray, gw: np.ndarray, rate: float) -> np.ndarray:
+    """``[points, column, distance, width, x..., weights...]`` rows: the far rules smaller
+    than the run's own (``gx, gw``, the last row, whose states come first in a row of
+    ``March.states``), with the least distance (interval widths) to a singular point and the
+    longest interval (the kernel's time unit; ``rate`` the fastest exponential's) each keeps."""
+    sizes = [p for p in _FAR_POINTS if p < gx.size] + [gx.size]
+    table = np.zeros((len(sizes), 4 + 2 * gx.size))
+    col = 1 + 5 * gx.size
+    for i, points in enumerate(sizes):
+        if points == gx.size:
+            x, w, column, distance, width = gx, gw, 0, 0.0, math.inf
+        else:
+            x, w = np.polynomial.legendre.leggauss(points)
+            x, w = 0.5 * (x + 1.0), 0.5 * w
+            rho = _FAR_ERROR ** (-0.5 / points)
+            distance = 0.25 * (rho + 1.0 / rho) - 0.5
+            coefficient = (2.0 ** (2 * points + 1) * math.factorial(points) ** 4
+                           / ((2 * points + 1) * math.factorial(2 * points) ** 3))
+            beta = 2.0 * (_FAR_EXP_ERROR / coefficient) ** (0.5 / points)
+            width = beta / rate if rate > 0.0 else math.inf
+            column, col = col, col + 1 + 5 * points
+        table[i, :4] = points, column, distance, width
+        table[i, 4:4 + points], table[i, 4 + points:4 + 2 * points] = x, w
+    return table
+
+
 @dataclass
 class EdgeModel:
     """A rigid pull of a flat punch in the kernels' units (their module's header): SI
@@ -134,6 +171,15 @@ class EdgeModel:
             rh = machine.law_array()
         return cls(R, sigma_c, delta, v, h0, 0 if scene.geometry.cohesive_zone == "external"
                    else 1, ts, np.array(rh, float), np.array(cr, float), machine)
+
+    @property
+    def fastest_rate(self) -> float:
+        """The fastest exponential of the creep's kernel and of a rigid pull's bonded load
+        (1 / kernel time unit; 0 for none)."""
+        rates = list(self.cr[2::2])
+        if self.rh[0] == self.rh[0]:
+            rates += [1.0 / tau for tau in self.rh[5::2]]
+        return max(rates, default=0.0)
 
     @property
     def fastest_creep(self) -> float:
@@ -225,7 +271,9 @@ class March:
         self.ctx = np.zeros(6)
         self.ctx[1] = self.model.zone
         # the history's intervals' Gauss states (kernels.history_integral), grown with it
-        self.states = np.zeros((256, 1 + 5 * self.gx.size))
+        self.rules = _rule_table(self.gx, self.gw, self.model.fastest_rate)
+        self.states = np.zeros((256, int(self.rules[-2, 1] + 1 + 5 * self.rules[-2, 0])
+                                if len(self.rules) > 1 else 1 + 5 * self.gx.size))
 
     def sigma_of(self, t: float, q: float) -> float:
         """The march's parameter at time ``t`` and progress ``q``: ``t / t_onset + q``, or
@@ -257,7 +305,8 @@ class March:
         self.evaluations += 1
         return kernels.edge_gap_split(self._context(t, 0.0, 1), self.model.rh,
                                       self.model.cr, self.hist, 0, self.segs, DEGREE, self.gx,
-                                      self.gw, self.graded, -math.inf, 1, self.states)
+                                      self.gw, self.graded, -math.inf, 1, self.states,
+                                      self.rules)
 
     def _trial(self, t, p, sigma, phase):
         """The history with a trial node after the accepted ones: ``(hist, n)``. A trial
@@ -301,7 +350,7 @@ class March:
             alone = self.trial_lift - self.machine.virtual_lift(t, *self.zero)
         if part < 0:
             split, part = -math.inf, 1
-        return kernels.edge_gap_split(*args, split, part, self.states) + alone
+        return kernels.edge_gap_split(*args, split, part, self.states, self.rules) + alone
 
     def push(self, t, p, sigma, q, new_piece=None):
         """A node; behind a machine spring with its bonded load and lift (a piece's first
@@ -313,7 +362,7 @@ class March:
             self.segs = np.vstack([self.segs, [[i, new_piece]]]).astype(np.int64)
         self.hist[:3, i] = t, p, sigma
         if i == 0:  # (a history begun again: see _unstable_onset)
-            self.states[:, 0] = 0.0
+            self.states[:, self.rules[:, 1].astype(np.int64)] = 0.0
         elif i >= self.states.shape[0]:
             self.states = np.concatenate([self.states, np.zeros_like(self.states)])
         if self.machine is not None:
