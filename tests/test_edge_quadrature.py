@@ -320,3 +320,49 @@ def test_far_intervals_are_integrated_as_well_as_by_the_runs_own_rule(name, tol,
     edge.run_at(edge.EdgeModel.from_scene(scene_of(name)), tol, math.inf)
     assert worst["calls"] > 100
     assert worst["far"] <= 1.1 * worst["own"] + 1e-13
+
+
+# ------------------------------------------------------------------ lifted past the onset
+@pytest.mark.parametrize("h0", [6e-6, 1.5e-5])
+def test_a_kelvin_voigt_bond_lifted_past_its_onset_jumps_to_the_closed_form_state(h0):
+    """``separation_kv`` lifted by ``h0`` at t = 0 (2 and 5 delta): the gap with the bond
+    pinned exceeds delta (MODEL.md: the onset is then at t = 0). Without instantaneous
+    compliance no element moves in the jump: ``u = h0`` on ``x < R``, 0 beyond, so
+    ``gap(b) = h0 (1 - (2/pi) asin(R/b))``, which is delta at ``b* = R / sin(pi/2 (1 -
+    delta/h0))``; the bond keeps ``a* = sqrt(b*^2 - ell^2)`` (edge condition, ``ell = 2 (G h0 +
+    eta v) / (sigma_c R)``), or where ``b* < ell`` it is gone and the zone alone holds ``b*``.
+    (Until the twenty-first session the march called this onset unstable, the punch off at
+    once with 0.84 mN.)"""
+    scene = scene_of("separation_kv", f"loading.h0={h0}")
+    model = edge.EdgeModel.from_scene(scene)
+    run = edge.March(model, 1e-6)
+    edge.find_onset(run)
+    assert run.t_on == 0.0
+    phase, p = edge._jump_at_zero(run, 0.0)
+    b_star = 1.0 / math.sin(0.5 * math.pi * (1.0 - 3e-6 / h0))
+    ell = 2.0 * (1e6 * h0 + 1e3 * 1e-3) / (1e6 * 1e-5)
+    a, b = model.radii(0.0, p, phase)
+    if b_star > ell:
+        assert phase == 2 and a == pytest.approx(math.sqrt(b_star ** 2 - ell ** 2), rel=1e-12)
+    else:
+        assert phase == 3 and a == 0.0
+    assert b == pytest.approx(b_star, rel=1e-12)
+
+
+def test_a_bond_lifted_past_its_onset_is_followed_until_its_zone_alone_grows():
+    """Past the jump the bond recedes to ``a = 0`` (0.2267 ms); then the zone alone grows
+    against the face, which this march does not follow, and the contact stepper refuses the
+    scene (it met the onset from below and ran on pinned: no separation in 0.3 s, 1.18 N):
+    the run says so, with the jump in its history and no separation time."""
+    res = solvers.simulate(scene_of("separation_kv", "loading.h0=6e-6", "numerics.rtol=1e-6"))
+    assert res.summary["solver"] == "edge_quadrature" and res.t_detach == 0.0
+    assert math.isnan(res.summary["t_separation"])
+    assert "lost its branch" in res.summary["notes"] and "lifted past the onset" in \
+        res.summary["notes"]
+    rows = res.history
+    assert rows["t"][1] == 0.0 and rows["a"][0] == 1e-5
+    assert rows["a"][1] == pytest.approx(0.2e-5, rel=1e-12)
+    assert rows["a"][-1] == 0.0 and 2.26e-4 < rows["t"][-1] < 2.28e-4
+    with pytest.raises(Exception, match="lifted past the onset"):
+        solvers.simulate(scene_of("separation_kv", "loading.h0=6e-6",
+                                  "numerics.method=stepper"))

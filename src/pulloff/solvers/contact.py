@@ -53,6 +53,21 @@ CONTROLLED = ("t_detach", "h_detach", "F_total_detach", "F_contact_detach", "t_s
               "h_jump_in", "F_jump_out", "h_jump_out", "energy_dissipated")
 
 
+def _lifted_past_the_onset(scene) -> float | None:
+    """``gap(0) / delta`` with the bond pinned where a flat punch pulled to separation by a
+    rigid machine at constant speed starts lifted past its onset (None otherwise). The
+    stepper's pinned bond ran on at ``a = R`` with the gap above delta (``separation_kv``
+    lifted by 2 delta: no separation in 0.3 s, 1.18 N; a review in the twentieth session)."""
+    loading = scene.loading
+    if (scene.geometry.kind != "flat_punch" or scene.model.until != "separation"
+            or loading.kind != "constant_velocity" or not loading.h0 > 0.0
+            or loading.machine_stiffness is not None):
+        return None
+    from .edge_quadrature import EdgeModel, March  # (the gap by quadrature; one call)
+    gap = March(EdgeModel.from_scene(scene), 1e-6).onset_gap(0.0)
+    return gap if gap > 1.0 + 1e-12 else None
+
+
 class ContactSolver(Solver):
     """Flat punches (the zone outside or on the face) pulled to separation, and any
     rheology, behind a rigid machine or a spring."""
@@ -124,6 +139,13 @@ class ContactSolver(Solver):
             out.append(problem_line(
                 "output.snapshots", list(scene.output.snapshots), "the contact solver stores "
                 "no displacement profiles yet"))
+        lifted = _lifted_past_the_onset(scene)
+        if lifted is not None:
+            out.append(problem_line(
+                "loading.h0", scene.loading.h0, f"lifted past the onset at t = 0 (the gap at "
+                f"the zone end is {lifted:.6g} delta with the bond pinned): the contact "
+                "stepper meets the onset as the gap reaching delta from below and would run "
+                "on without it (the edge quadrature takes such pulls)"))
         return out + stepper_settings(scene, "contact")
 
     def solve(self, scene, observers) -> Result:

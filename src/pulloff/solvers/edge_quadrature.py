@@ -553,6 +553,41 @@ def _unstable_onset(run: March, r_on: float) -> bool:
     return g > 1.0 + 1e-12
 
 
+#: Samples of each phase's measure in the search for the state a bond lifted past its onset
+#: at t = 0 jumps to (:func:`_jump_at_zero`).
+_JUMP_SAMPLES = 32
+
+
+def _jump_at_zero(run: March, r_on: float):
+    """Lifted past its onset at ``t = 0`` (``gap > delta`` with the bond pinned): the state it
+    jumps to at once, ``(phase, p)``, the first on the receding path from the pinned bond
+    (the bond radius down to 0, then the zone end down to 0) where the gap is back at
+    ``delta``; None where there is none (the punch comes off at once). Without instantaneous
+    compliance the elements keep their displacements through the jump (MODEL.md 6: free
+    elements start at ``u = 0``, the bonded ones at ``h0``), so a smaller bond, or the zone
+    alone, closes the gap: a Kelvin-Voigt punch lifted by ``2 delta`` keeps ``a = 0.2 R``;
+    an elastic solid follows at once and opens further (off at once, as the reference)."""
+    run.push(0.0, r_on, 0.0, 0.0, new_piece=2)
+    b0 = run.model.ell(0.0) ** 2
+    try:
+        for phase, start, end in ((2, r_on, 1.0), (3, b0, 0.0)):
+            def excess(p, phase=phase):
+                return run.gap(0.0, p, phase, 0.0) - 1.0
+
+            lo, g_lo = start, excess(start)
+            for k in range(1, _JUMP_SAMPLES + 1):
+                hi = start + (end - start) * k / _JUMP_SAMPLES
+                g_hi = excess(hi)
+                if g_hi <= 0.0:
+                    return phase, illinois(excess, min(lo, hi), max(lo, hi),
+                                           g_lo if lo < hi else g_hi,
+                                           g_hi if lo < hi else g_lo, 1e-15)
+                lo, g_lo = hi, g_hi
+        return None
+    finally:
+        run.n, run.segs = 0, run.segs[:0]
+
+
 def _snaps_at_a_zero(run: March, t: float, b0: float) -> bool:
     """Behind a machine spring, whether the zone alone cannot hold the punch where ``a``
     reaches 0: the gap's slope in ``b^2`` at that time, the punch moving with the zone (the
@@ -598,12 +633,19 @@ def march(run: March) -> None:
     model = run.model
     ell_on = model.ell(run.t_on)
     r_on = 0.0 if model.zone == 0 else ell_on ** 2
-    if _unstable_onset(run, r_on):
-        run.end = "unstable_onset"
-        return
     a_on2 = 1.0 - r_on
     ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
-    run.push(run.t_on, r_on, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=2)
+    if run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12:
+        jump = _jump_at_zero(run, r_on)
+        if jump is None:
+            run.end = "unstable_onset"
+            return
+        ph = _Phase(2, jump[1], ph.width) if jump[0] == 2 else _Phase(3, jump[1], 0.0)
+        run.t_zero = 0.0 if jump[0] == 3 else run.t_zero
+    elif _unstable_onset(run, r_on):
+        run.end = "unstable_onset"
+        return
+    run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase)
     piece, step = 0, run.first_step
     retries, crossed = 0, False
     while True:
@@ -797,7 +839,10 @@ def history(run: March) -> dict:
     t_first = run.t_on if math.isfinite(run.t_on) else run.t_limit
     rigid = model.machine is None
     rows = []
-    for t in np.linspace(0.0, t_first, ONSET_ROWS + 1)[:-1 if run.n else None]:
+    # (one row where the onset is at t = 0: the pinned state, before a jump)
+    times = np.linspace(0.0, t_first, ONSET_ROWS + 1)[:-1 if run.n else None] if t_first > 0.0 \
+        else np.zeros(1)
+    for t in times:
         rows.append((t, 0.0, 1, run.onset_gap(t), None, None if rigid else model.lift(t)))
     phases = _phases(run)
     last = run.n - 1 if run.end == "fold" else run.n
@@ -964,11 +1009,21 @@ class EdgeQuadratureSolver(Solver):
             # separation_kv lifted by 1.5e-6 m and pulled at 1e-2 m/s, found by a review)
             if fine is None or _handed_over(fine, model, t_limit) or not estimate <= rtol:
                 from .contact import ContactSolver
-                return ContactSolver().solve(scene, observers)
+                if not ContactSolver().unsupported(scene):
+                    return ContactSolver().solve(scene, observers)
+                # no solver goes further (a bond lifted past its onset at t = 0 whose zone
+                # alone then grows against the face): what this one found, and why it stops
+                run = fine if fine is not None else coarse
+                return _result(scene, model, run, math.inf, coarse.evaluations + (
+                    fine.evaluations if fine is not None else 0), observers,
+                    time.perf_counter() - wall)
         if model.machine is not None:  # (both marches share the lift path before the onset)
             estimate += model.machine.path_error
         return _result(scene, model, fine, estimate, coarse.evaluations + fine.evaluations,
                        observers, time.perf_counter() - wall)
+
+
+_PHASE_NAMES = {2: "the bond receding", 3: "the zone alone"}
 
 
 def _notes(run: March, scene, estimate: float) -> list:
@@ -981,6 +1036,12 @@ def _notes(run: March, scene, estimate: float) -> list:
     elif run.end == "snap":
         notes.append("the zone alone cannot hold the punch behind the machine spring where "
                      "the bond radius reaches 0: it snaps off there")
+    elif run.end in ("lost", "bond_fold"):
+        from .contact import ContactSolver
+        notes.append(f"no separation time: the march lost its branch at t = "
+                     f"{run.hist[0, run.n - 1] * run.model.time_scale:.6g} s "
+                     f"({_PHASE_NAMES[_phases(run)[-1]]}), and the contact stepper does not "
+                     "take the scene: " + "; ".join(ContactSolver().unsupported(scene)))
     elif run.end == "unstable_onset":
         notes.append("the onset is unstable (a receding edge opens the gap further): the "
                      "punch comes off at once")
