@@ -614,3 +614,98 @@ def test_property_the_cohesive_force_of_an_array_is_each_of_its_rows_alone(S):
     rows = A.cohesive_force(2.0, 1.0, b)
     assert rows.shape == b.shape
     assert rows.tolist() == [A.cohesive_force(2.0, 1.0, float(x)) for x in b.tolist()]
+
+
+# ---------------------------------------------------------------------------------------------
+# The compiled root solves (pulloff.kernels.closed_forms) against the Python forms they replace
+# on a run's hot path. Tolerance: none, bit for bit (the same operations in the same order and
+# the same C library functions; a difference would show a contracted multiply-add or another
+# math library).
+# ---------------------------------------------------------------------------------------------
+
+
+def test_compiled_seed_t_star_is_the_python_solve_bit_for_bit():
+    from pulloff.kernels import closed_forms
+    from pulloff.solvers.problem import compiled_t_star
+
+    f_series = np.array(A._F_SERIES)
+    alphas = np.concatenate((np.geomspace(1e-4, 100.0, 2001), [1e-4, 100.0, 1.0, A.ALPHA_SWITCH]))
+    for al in alphas.tolist():
+        got = closed_forms.root(closed_forms.SEED, al, 0.0, 0.0, math.inf, f_series)
+        assert got == A._t_star_scalar(al), al
+    # the wrapper: the series below 1e-4 and the fixed point above 100 stay in Python
+    for al in [0.0, 1e-12, 9.9e-5, *np.geomspace(1e-6, 1e8, 301).tolist(), math.inf]:
+        assert compiled_t_star(al) == A.seed_t_star(al), al
+    with pytest.raises(ValueError):
+        compiled_t_star(-1.0)
+
+
+def test_compiled_elastic_zone_is_the_python_solve_bit_for_bit():
+    from pulloff.kernels import closed_forms
+    from pulloff.solvers.problem import compiled_elastic_zone
+
+    g_series = np.array(A._G_SERIES)
+    for chi in np.geomspace(1e-14, 1e3, 2001).tolist() + [1e-2 ** 2 / 2, A._PI_2_M1]:
+        got = closed_forms.root(closed_forms.ELASTIC, chi, 0.0, 0.0, math.inf, g_series)
+        assert got == A._elastic_zone(chi), chi
+        assert compiled_elastic_zone(chi) == A._elastic_zone(chi), chi
+
+
+def _python_frozen_onset(k, c, h0, t_limit):
+    """The frozen onset as pulloff.solvers.frozen computed it in Python before
+    kernels.closed_forms.frozen_onset: the reference of the test below."""
+    def memory(t):
+        if c == 0.0:
+            return 1.0 / k, 0.0
+        if k == 0.0:
+            return t / c, 1.0 / c
+        return -math.expm1(-k * t / c) / k, math.exp(-k * t / c) / c
+
+    def gap(t):
+        s = k * (h0 + t) + c
+        return (2.0 / math.pi) * ((h0 + t) * math.atan(s)
+                                  - s * s / (1.0 + math.sqrt(1.0 + s * s)) * memory(t)[0])
+
+    def slope(t):
+        s = k * (h0 + t) + c
+        m, dm = memory(t)
+        root = math.sqrt(1.0 + s * s)
+        return (2.0 / math.pi) * (math.atan(s) + (h0 + t) * k / (1.0 + s * s)
+                                  - k * s / root * m - s * s / (1.0 + root) * dm)
+
+    if gap(0.0) >= 1.0:
+        return 0.0
+    hi = 1.0
+    while gap(hi) < 1.0:
+        if hi > t_limit:
+            return math.inf
+        hi *= 2.0
+    lo = hi / 2.0 if hi > 1.0 else 0.0
+    return A.bracketed_newton(lambda t: gap(t) - 1.0, slope, lo, hi, hi)
+
+
+def test_compiled_frozen_onset_is_the_python_solve_bit_for_bit():
+    from pulloff.kernels import closed_forms
+
+    rng = np.random.default_rng(5)
+    cases = [(k, c, h0, t_limit)
+             for k, c in [(0.012, 1.2), (1e-6, 1e3), (1e4, 1e-6), (3.0, 0.0), (0.0, 2.0)]
+             for h0 in (0.0, 0.5, 1e4) for t_limit in (math.inf, 3.0)]
+    cases += [(10 ** rng.uniform(-8, 6), 10 ** rng.uniform(-8, 6), rng.choice([0.0, 2.0]),
+               math.inf) for _ in range(2000)]
+    for k, c, h0, t_limit in cases:
+        got = closed_forms.root(closed_forms.FROZEN, float(k), float(c), float(h0),
+                                float(t_limit), np.empty(0))
+        assert got == _python_frozen_onset(k, c, h0, t_limit), (k, c, h0, t_limit)
+
+
+def test_compiled_predictions_are_the_python_ones():
+    """What an onset run reports beside it (solvers.problem.predictions, compiled solves) is
+    analytic.predictions bit for bit, on every branch of eq. 53's solve."""
+    from pulloff.io.scene_file import scene_from_groups
+    from pulloff.solvers.problem import predictions
+
+    for al in (1e-6, 1e-3, 0.1, 1.0, 3.3, 10.0, 1e3, 1e6):
+        for chi in (1e-8, 1e-4, 1.0, 30.0):
+            scene = scene_from_groups(al, chi)
+            assert predictions(scene) == A.predictions(scene), (al, chi)

@@ -625,22 +625,29 @@ def test_property_the_contact_view_is_a_scan_of_every_element(data, n, n_arms):
             assert got == sum(kappa[i] * want[i] for i in range(n_arms))
 
 
-def test_compiled_horner_is_numpys_bit_for_bit():
-    """The history's cohesive force with the compiled Horner sum (kernels.history.horner, what
-    si_history passes) equals the numpy one bit for bit: thin zones (all of the series), wide
-    ones (series and closed form mixed), short arrays (summed in Python floats), empty ones."""
-    from pulloff.model import analytic
-    from pulloff.solvers.problem import compiled_horner
+def test_compiled_history_columns_are_numpys_bit_for_bit():
+    """si_history's one compiled pass (kernels.history.flat_punch_columns) equals the numpy
+    columns bit for bit: thin zones (all of the cohesive series), wide ones (series and closed
+    form mixed), a preload, the elastic and viscous limits; empty, short and long histories,
+    and a 2-d shape."""
+    from pulloff.solvers.problem import Problem, numpy_si_history, si_history
 
     rng = np.random.default_rng(11)
-    a = 1e-3
-    for S_max in (1e-8, 1e-3, 0.3, 0.5, 0.7, 3.0, 300.0):
-        for n in (0, 1, 5, 16, 17, 257, 1000):
-            S = S_max * rng.random(n)
-            b = a * np.sqrt(1.0 + S * S)
-            want = analytic.cohesive_force(2e5, a, b)
-            got = analytic.cohesive_force(2e5, a, b, horner=compiled_horner)
-            assert got.tobytes() == want.tobytes(), (S_max, n)
-    x = rng.random((3, 4))
-    coeffs = [0.5, -0.25, 1.0 / 3.0]
-    assert compiled_horner(coeffs, x).tobytes() == analytic._horner(coeffs, x).tobytes()
+    problems = [Problem(G=3e5, eta=3e3, sigma_c=5e6, delta=1e-8, a=1e-3, v=1e-3),
+                Problem(G=1e6, eta=50.0, sigma_c=1e6, delta=3.1831e-12, a=1e-3, v=1e-3),
+                Problem(G=1e6, eta=1e3, sigma_c=1e6, delta=1e-4, a=1e-3, v=1e-3, h0=2e-5),
+                Problem(G=1e6, eta=0.0, sigma_c=1e6, delta=1e-6, a=1e-3, v=4e-5),
+                Problem(G=0.0, eta=1e5, sigma_c=1e6, delta=1e-7, a=1e-3, v=1e-3)]
+    for p in problems:
+        for t_max in (1e-6, 1.0, 1e3, 1e6):
+            for n in (0, 1, 5, 16, 17, 257, 1000):
+                t = np.sort(t_max * rng.random(n))
+                gap = rng.random(n)
+                got, want = si_history(p, t, gap), numpy_si_history(p, t, gap)
+                assert list(got) == list(want)
+                for name in want:
+                    assert got[name].tobytes() == want[name].tobytes(), (p, t_max, n, name)
+    t, gap = rng.random((3, 4)), rng.random((3, 4))
+    got, want = si_history(problems[0], t, gap), numpy_si_history(problems[0], t, gap)
+    assert all(got[name].tobytes() == want[name].tobytes() for name in want)
+    assert all(got[name].shape == (3, 4) for name in want)

@@ -381,13 +381,15 @@ def _check_params(G, eta, sigma_c, delta, a, v):
         raise ValueError("G and eta cannot both be 0 (the half-space would offer no resistance)")
 
 
-def seed_linearised(G, eta, sigma_c, delta, a, v):
+def seed_linearised(G, eta, sigma_c, delta, a, v, t_star=None):
     """The seed's linearised model solved without further approximation.
 
     Eq. 53 is solved numerically for ``t* = t G / eta``, and the force is eq. 48,
     ``F = 8 a (G v t + eta v)``.  Inputs: G [Pa], eta [Pa s], sigma_c [Pa], delta [m], a [m],
     v [m/s] (scalars; G, eta >= 0, not both 0).  Returns
     ``dict(t_detach=[s], h_detach=[m], F=[N])`` with ``h_detach = v t_detach``.
+    ``t_star(alpha)`` solves eq. 53 (default :func:`seed_t_star`; the solvers pass a compiled
+    one with the same bits: this module stays free of numba).
 
     Like the seed (eq. 9) this assumes ``h0 = 0`` and ignores any initial lift.
 
@@ -399,6 +401,7 @@ def seed_linearised(G, eta, sigma_c, delta, a, v):
     """
     _check_params(G, eta, sigma_c, delta, a, v)
     G, eta, sigma_c, delta, a, v = map(float, (G, eta, sigma_c, delta, a, v))
+    t_star = t_star or seed_t_star
     if eta == 0.0:
         t = math.sqrt(math.pi * delta * a * sigma_c / (2.0 * G)) / v
     elif G == 0.0:
@@ -409,13 +412,13 @@ def seed_linearised(G, eta, sigma_c, delta, a, v):
             # t = (t*/alpha) * (alpha eta/G); the second factor does not involve G, so this
             # stays finite and accurate as G -> 0 (where t* = alpha eta/G alone would be 0/0)
             ratio = 2.0 if al == 0.0 else (
-                _t_over_alpha_series(al) if al < _ALPHA_SERIES_MAX else seed_t_star(al) / al
+                _t_over_alpha_series(al) if al < _ALPHA_SERIES_MAX else t_star(al) / al
             )
             t = ratio * math.pi * delta * sigma_c * a / (4.0 * v * v * eta)
         else:
             # t = (t*/sqrt(2 alpha + 1)) * (sqrt(2 alpha + 1) eta/G); the second factor is eq. 61,
             # finite as eta -> 0 even where alpha itself overflows
-            ratio = 1.0 if math.isinf(al) else seed_t_star(al) / math.sqrt(2.0 * al + 1.0)
+            ratio = 1.0 if math.isinf(al) else t_star(al) / math.sqrt(2.0 * al + 1.0)
             t = ratio * math.sqrt(math.pi * delta * sigma_c * a / (2.0 * G) + (eta * v / G) ** 2) / v
     F = 8.0 * a * (G * v * t + eta * v)
     return dict(t_detach=t, h_detach=v * t, F=F)
@@ -468,6 +471,8 @@ def viscous_force(eta, v, a):
 
     Inputs: eta [Pa s], v [m/s], a [m].  Returns [N].
     """
+    if _all_floats(eta, v, a):  # (the same products without a 0-d array: 1 us a run)
+        return 8.0 * eta * v * a
     return _out(8.0 * np.asarray(eta, dtype=float) * v * a)
 
 
@@ -527,7 +532,7 @@ def _g_gap_prime(S):
     return math.atan(S) + S / (1.0 + S * S) - S / math.sqrt(1.0 + S * S)
 
 
-def elastic_mdr_dugdale(G, sigma_c, delta, a):
+def elastic_mdr_dugdale(G, sigma_c, delta, a, zone=None):
     """Exact elastic (``eta = 0``) MDR-Dugdale flat punch at the onset of detachment.
 
     Inputs: G [Pa] (> 0), sigma_c [Pa], delta [m], a [m].  With ``S = sqrt(b^2 - a^2)/a`` the two
@@ -543,29 +548,33 @@ def elastic_mdr_dugdale(G, sigma_c, delta, a):
     ``S`` is returned as well because ``b`` as a float cannot resolve ``b - a`` (= a S^2/2 for
     thin zones) below ~1e-16 a.  Both forces tend to Kendall (eq. 95) as ``chi -> 0``:
     ``F_contact/F_K = 1 + 5 chi/12 + ...``, ``F_total/F_K = 1 + 13 chi/12 + ...``.
+    ``zone(chi)`` solves ``g(S) = chi > 0`` (default: :func:`_elastic_zone`; the solvers
+    pass a compiled one with the same bits).
     """
     G, sigma_c, delta, a = map(float, (G, sigma_c, delta, a))
     if not (G > 0 and sigma_c > 0 and a > 0 and delta >= 0):
         raise ValueError("need G > 0, sigma_c > 0, a > 0, delta >= 0")
     c = math.pi * G * delta / (sigma_c * a)
-    if c == 0.0:
-        S = 0.0
-    else:
-        # g(S) <= S^2/2 and g(S) <= (pi/2 - 1) S for all S (g/S = theta - tan(theta/2) increases
-        # to pi/2 - 1 with theta = atan S), so the root is at least the larger of the two
-        # asymptotic solutions; the doubling loop finds the upper end in a step or two.
-        lo = max(math.sqrt(2.0 * c), c / _PI_2_M1)
-        while _g_gap(lo) > c:
-            lo *= 0.5
-        hi = 2.0 * lo
-        while _g_gap(hi) < c:
-            hi *= 2.0
-        S = bracketed_newton(lambda s: _g_gap(s) - c, _g_gap_prime, lo, hi, lo)
+    S = 0.0 if c == 0.0 else (zone or _elastic_zone)(c)
     h = sigma_c * a * S / (2.0 * G)
     b = a * math.sqrt(1.0 + S * S)
     F_contact = 8.0 * a * G * h
     F_total = 2.0 * sigma_c * a * a * (S + (1.0 + S * S) * math.atan(S))
     return dict(b=b, h=h, F_contact=F_contact, F_total=F_total, S=S)
+
+
+def _elastic_zone(c: float) -> float:
+    """The root ``S`` of ``g(S) = c > 0`` (:func:`elastic_mdr_dugdale`)."""
+    # g(S) <= S^2/2 and g(S) <= (pi/2 - 1) S for all S (g/S = theta - tan(theta/2) increases
+    # to pi/2 - 1 with theta = atan S), so the root is at least the larger of the two
+    # asymptotic solutions; the doubling loop finds the upper end in a step or two.
+    lo = max(math.sqrt(2.0 * c), c / _PI_2_M1)
+    while _g_gap(lo) > c:
+        lo *= 0.5
+    hi = 2.0 * lo
+    while _g_gap(hi) < c:
+        hi *= 2.0
+    return bracketed_newton(lambda s: _g_gap(s) - c, _g_gap_prime, lo, hi, lo)
 
 
 def elastic_internal_onset(G, sigma_c, delta, R):
@@ -620,13 +629,12 @@ _COH_SERIES = [(-1) ** (n + 1) * 2.0 / ((2 * n - 1) * (2 * n + 1)) for n in rang
 _COH_SERIES_MAX_S = 0.5
 
 
-def _cohesive_bracket(S, horner=_horner):
-    """``(1 + S^2) atan(S) - S`` for an array ``S >= 0``, to ~1e-15 relative (``horner``: see
-    :func:`cohesive_force`)."""
+def _cohesive_bracket(S):
+    """``(1 + S^2) atan(S) - S`` for an array ``S >= 0``, to ~1e-15 relative."""
     S = np.asarray(S, dtype=float)
     small = S < _COH_SERIES_MAX_S
     if small.all():  # (a thin zone's whole history: no masks)
-        return _cohesive_series(S, horner)
+        return _cohesive_series(S)
     # math.atan, not np.arctan: numpy's vectorised arctan may round differently in the last
     # bit (it did on an Intel Xeon, not on an AMD EPYC), and a history's row must be the
     # scalar path's value whatever the machine.
@@ -634,15 +642,15 @@ def _cohesive_bracket(S, horner=_horner):
     with np.errstate(over="ignore", invalid="ignore"):
         out = (1.0 + S * S) * atan - S
     if small.any():
-        out[small] = _cohesive_series(S[small], horner)
+        out[small] = _cohesive_series(S[small])
     return out
 
 
-def _cohesive_series(S, horner=_horner):
+def _cohesive_series(S):
     """The series below ``S = 0.5``, all its terms (as :func:`_cohesive_force_scalar`, bit
     for bit; a truncation chosen per array made an element depend on its neighbours)."""
     s2 = S * S
-    return S * s2 * horner(_COH_SERIES, s2)
+    return S * s2 * _horner(_COH_SERIES, s2)
 
 
 def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
@@ -658,15 +666,14 @@ def _cohesive_force_scalar(sigma_c: float, a: float, b: float) -> float:
     return 2.0 * sigma_c * a * a * bracket
 
 
-def cohesive_force(sigma_c, a, b, horner=None):
+def cohesive_force(sigma_c, a, b):
     """Force of the cohesive annulus ``a < r < b`` alone, in [N] (MODEL.md section 3).
 
     ``sigma_c [pi b^2 - 2 a sqrt(b^2-a^2) - 2 b^2 asin(a/b)] = 2 sigma_c a^2 [(1+S^2) atan S - S]``
     with ``S = sqrt(b^2 - a^2)/a``; inputs sigma_c [Pa], a [m], b [m] (``b >= a``; ``b`` may be an
     array).  For small ``S`` the force is ``~ (4/3) sigma_c a^2 S^3`` and both forms cancel
     catastrophically, so a series is used below ``S = 0.5``; accurate to ~1e-15 relative.
-    ``horner(coeffs, x)`` sums the series over an array ``x`` with the operations of
-    :func:`_horner` (the solvers pass a compiled one; this module stays free of numba).
+    (A run's history is summed by a compiled twin, :mod:`pulloff.kernels.history`.)
     """
     a = float(a)
     if np.ndim(b) == 0:
@@ -676,12 +683,13 @@ def cohesive_force(sigma_c, a, b, horner=None):
         raise ValueError("cohesive_force needs b >= a")
     # (b - a) is exact for b <= 2a (Sterbenz), so S keeps full relative precision for thin zones
     S = np.sqrt((b - a) * (b + a)) / a
-    return _out(2.0 * sigma_c * a * a * _cohesive_bracket(S, horner or _horner))
+    return _out(2.0 * sigma_c * a * a * _cohesive_bracket(S))
 
 
-def predictions(scene) -> dict:
+def predictions(scene, t_star=None, elastic_zone=None) -> dict:
     """The closed forms beside a flat-punch pull, SI, keyed as in :mod:`pulloff.model.outputs`
-    (nan where a formula does not apply).
+    (nan where a formula does not apply). ``t_star`` and ``elastic_zone``: the root solves
+    (see :func:`seed_linearised` and :func:`elastic_mdr_dugdale`; default the Python ones).
 
     With the zone on the punch face (``cohesive_zone: internal``) the elastic MDR-Dugdale forces
     are those of :func:`elastic_internal_onset` (``elastic_b`` is then the radius); the seed's
@@ -698,7 +706,7 @@ def predictions(scene) -> dict:
                          "seed_closed_form_t_detach", "seed_closed_form_F"), nan)
     out["seed_closed_form_branch"] = ""
     if not internal:
-        lin = seed_linearised(G, eta, sigma_c, delta, a, v)
+        lin = seed_linearised(G, eta, sigma_c, delta, a, v, t_star)
         closed = seed_closed_form(G, eta, sigma_c, delta, a, v)
         out.update(seed_linearised_t_detach=lin["t_detach"], seed_linearised_F=lin["F"],
                    seed_closed_form_t_detach=closed["t_detach"], seed_closed_form_F=closed["F"],
@@ -707,19 +715,20 @@ def predictions(scene) -> dict:
     out["viscous_F"] = viscous_force(eta, v, a)
     out["elastic_F_contact"] = out["elastic_F_total"] = out["elastic_b"] = nan
     if G > 0:
-        el = _elastic_onset(G, sigma_c, delta, a, internal)
+        el = _elastic_onset(G, sigma_c, delta, a, internal, elastic_zone)
         out.update(elastic_F_contact=el["F_contact"], elastic_F_total=el["F_total"],
                    elastic_b=a if internal else el["b"])
     out["elastic_instant_F_contact"] = out["elastic_instant_F_total"] = nan
     if spectrum.arms:
-        el = _elastic_onset(spectrum.instantaneous_modulus, sigma_c, delta, a, internal)
+        el = _elastic_onset(spectrum.instantaneous_modulus, sigma_c, delta, a, internal,
+                            elastic_zone)
         out.update(elastic_instant_F_contact=el["F_contact"], elastic_instant_F_total=el["F_total"])
     return out
 
 
-def _elastic_onset(G, sigma_c, delta, a, internal):
+def _elastic_onset(G, sigma_c, delta, a, internal, zone=None):
     return (elastic_internal_onset(G, sigma_c, delta, a) if internal
-            else elastic_mdr_dugdale(G, sigma_c, delta, a))
+            else elastic_mdr_dugdale(G, sigma_c, delta, a, zone))
 
 
 PATH_KEYS = ("mdr_dugdale_F_pulloff_load", "mdr_dugdale_F_pulloff_displacement",

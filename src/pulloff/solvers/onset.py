@@ -24,12 +24,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kernels import onset as kernels
-from ..model import analytic
 from . import levels as ladder
 from .base import Solver, flat_punch_pull, problem as problem_line, stepper_settings
 from .frozen import frozen_detach_time, frozen_gap, zone_ratio
 from .observers import decimate, no_progress, stream_every
-from .problem import Problem, si_history
+from .problem import Problem, predictions, si_history
 from .result import Result
 
 #: The ladder reports the Richardson extrapolation of its last two levels, whose error falls
@@ -622,6 +621,6 @@ def assemble(scene, problem: Problem, run: FoundationRun, estimate: float, order
     summary.update(extra or {})
     snapshots = [(ts * T, problem.a * np.sqrt(1.0 + sig * sig), problem.delta * U)
                  for ts, sig, U in run.snapshots]
-    return Result.build(summary, analytic.predictions(scene), si_history(problem, t_hist, gap_hist),
+    return Result.build(summary, predictions(scene), si_history(problem, t_hist, gap_hist),
                         snapshots=snapshots, notes=notes, complete=not run.interrupted,
                         history_streamed=streamed, problem=problem)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kernels import history as history_kernels
+from ..kernels import closed_forms, history as history_kernels
 from ..model import analytic
 
 
@@ -111,7 +111,25 @@ class Problem:
 
 def si_history(problem: "Problem", t, gap) -> dict:
     """History columns in SI (:mod:`pulloff.model.outputs`) of the flat punch with its bond
-    radius fixed, from dimensionless times and gaps."""
+    radius fixed, from dimensionless times and gaps (arrays of one shape). A rigid pull's
+    in one compiled pass (:func:`pulloff.kernels.history.flat_punch_columns`, the bits of
+    :func:`numpy_si_history`, which a subclass's own lift and zone take)."""
+    if type(problem) is not Problem:
+        return numpy_si_history(problem, t, gap)
+    t = np.asarray(t, dtype=float)
+    flat_t = np.ascontiguousarray(t.reshape(-1))
+    flat_gap = np.ascontiguousarray(np.asarray(gap, dtype=float).reshape(-1))
+    out = np.empty((len(history_kernels.COLUMNS), flat_t.size))
+    p = problem
+    if not history_kernels.flat_punch_columns(
+            flat_t, flat_gap, p.k, p.c, p.h0_scaled, p.time_scale, p.h0, p.v, p.a, p.delta, p.G,
+            p.eta, p.sigma_c, _COH_SERIES, out):
+        raise ValueError("cohesive_force needs b >= a")
+    return {name: row.reshape(t.shape) for name, row in zip(history_kernels.COLUMNS, out)}
+
+
+def numpy_si_history(problem: "Problem", t, gap) -> dict:
+    """:func:`si_history` from the problem's own SI views, in numpy."""
     b = problem.zone_end(t)
     F_contact = problem.contact_force(t)
     return {
@@ -122,24 +140,32 @@ def si_history(problem: "Problem", t, gap) -> dict:
         "gap": gap * problem.delta,
         "F_contact": F_contact,
         # (total_force's own sum, without computing b and F_contact again)
-        "F_total": F_contact + analytic.cohesive_force(problem.sigma_c, problem.a, b,
-                                                       horner=compiled_horner),
+        "F_total": F_contact + analytic.cohesive_force(problem.sigma_c, problem.a, b),
         "segment": np.zeros(np.shape(t)),  # a pull is one segment
     }
 
 
-#: Coefficient lists of :func:`compiled_horner` as arrays, by ``id`` (with the list itself, so
-#: that an id is never reused for another list while it is here).
-_COEFFICIENT_ARRAYS: dict = {}
+# The closed forms beside a run with their root solves compiled (pulloff.kernels.closed_forms,
+# the same bits): in Python the solves were ~10 us of a ~0.3 ms onset run.
+_F_SERIES = np.array(analytic._F_SERIES)
+_COH_SERIES = np.array(analytic._COH_SERIES)
+_G_SERIES = np.array(analytic._G_SERIES)
 
 
-def compiled_horner(coeffs, x) -> np.ndarray:
-    """:func:`pulloff.model.analytic._horner` compiled (:func:`pulloff.kernels.history.horner`:
-    the same operations, so the same bits): ``sum_j coeffs[j] x^j`` for an array ``x``."""
-    entry = _COEFFICIENT_ARRAYS.get(id(coeffs))
-    if entry is None or entry[0] is not coeffs:
-        entry = _COEFFICIENT_ARRAYS[id(coeffs)] = (coeffs, np.array(coeffs, dtype=float))
-    x = np.ascontiguousarray(x, dtype=float)
-    out = np.empty(x.shape)
-    history_kernels.horner(entry[1], x.reshape(-1), out.reshape(-1))
-    return out
+def compiled_t_star(alpha: float) -> float:
+    """:func:`pulloff.model.analytic.seed_t_star` (dimensionless), its bracketed Newton
+    compiled; the series (below 1e-4) and fixed point (above 100) stay in Python (cheap,
+    and the fixed point's ``(t + 1) ** 2`` is the C library's ``pow``)."""
+    if analytic._ALPHA_SERIES_MAX <= alpha <= analytic._ALPHA_FIXED_POINT_MIN:
+        return closed_forms.root(closed_forms.SEED, alpha, 0.0, 0.0, math.inf, _F_SERIES)
+    return analytic.seed_t_star(alpha)
+
+
+def compiled_elastic_zone(chi: float) -> float:
+    """The elastic onset's ``S`` for ``g(S) = chi > 0`` (dimensionless), compiled."""
+    return closed_forms.root(closed_forms.ELASTIC, chi, 0.0, 0.0, math.inf, _G_SERIES)
+
+
+def predictions(scene) -> dict:
+    """:func:`pulloff.model.analytic.predictions` with the compiled root solves (SI)."""
+    return analytic.predictions(scene, compiled_t_star, compiled_elastic_zone)
