@@ -651,3 +651,25 @@ def test_compiled_history_columns_are_numpys_bit_for_bit():
     got, want = si_history(problems[0], t, gap), numpy_si_history(problems[0], t, gap)
     assert all(got[name].tobytes() == want[name].tobytes() for name in want)
     assert all(got[name].shape == (3, 4) for name in want)
+
+
+def test_scalar_forces_with_the_compiled_series_are_analytics_bit_for_bit():
+    """Problem.forces at one time (the cohesive series compiled, kernels.history.
+    cohesive_bracket) and zone_ratio of a float (math) equal the Python/numpy forms bit for
+    bit, in thin zones (series), wide ones (closed form) and at the switch."""
+    from pulloff.model import analytic
+    from pulloff.solvers.frozen import zone_ratio
+    from pulloff.solvers.problem import Problem
+
+    rng = np.random.default_rng(7)
+    for p in (Problem(G=3e5, eta=3e3, sigma_c=5e6, delta=1e-8, a=1e-3, v=1e-3),
+              Problem(G=1e6, eta=1e3, sigma_c=1e6, delta=1e-4, a=1e-3, v=1e-3, h0=2e-5),
+              Problem(G=0.0, eta=1e5, sigma_c=1e6, delta=1e-7, a=1e-3, v=1e-3)):
+        times = [0.0, *(10.0 ** rng.uniform(-6, 6, 500)).tolist()]
+        for t in times:
+            F_contact, F_total = p.forces(t)
+            b = p.zone_end(t)
+            want = F_contact + analytic._cohesive_force_scalar(p.sigma_c, p.a, b)
+            assert type(F_total) is float and F_total == want, (p, t)
+            s = p.s_of(t)
+            assert zone_ratio(s) == zone_ratio(np.array([s]))[0]

@@ -378,3 +378,19 @@ def test_a_slow_solid_behind_a_soft_spring_detaches_where_an_independent_solver_
     h = res.history
     balance = k_m * (res.problem.v * h["t"] - h["h"]) - h["F_total"]
     assert np.max(np.abs(balance)) <= 1e-12 * np.max(h["F_total"])
+
+
+def test_uniform_rows_are_linspace_bit_for_bit():
+    """The history's row times (onset_quadrature._uniform, without linspace's Python) are
+    np.linspace(0, end, n) bit for bit, underflowing steps and non-finite ends included."""
+    from pulloff.solvers.onset_quadrature import _uniform
+
+    rng = np.random.default_rng(3)
+    for _ in range(3000):
+        end = rng.uniform(0.5, 2.0) * 10.0 ** rng.uniform(-300, 300)
+        n = int(rng.integers(2, 3000))
+        assert _uniform(end, n).tobytes() == np.linspace(0.0, end, n).tobytes(), (end, n)
+    with np.errstate(invalid="ignore"):
+        for end in (0.0, 5e-324, 1e-310, math.inf, math.nan):
+            for n in (2, 3, 257):
+                assert np.array_equal(_uniform(end, n), np.linspace(0.0, end, n), equal_nan=True)

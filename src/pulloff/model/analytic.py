@@ -72,7 +72,10 @@ _EPS = np.finfo(float).eps
 
 def _all_floats(*values) -> bool:
     """Whether every value is a Python float (a scene's numbers are): the scalar forms apply."""
-    return all(type(x) is float for x in values)
+    for x in values:  # (a loop, not all() over a generator: half the ~1 us, 6 calls a run)
+        if type(x) is not float:
+            return False
+    return True
 
 
 def _out(x):
@@ -367,6 +370,10 @@ def taylor_poly(t_star, degree):
 
 
 def _check_params(G, eta, sigma_c, delta, a, v):
+    if (_all_floats(G, eta, sigma_c, delta, a, v) and sigma_c > 0 and delta > 0 and a > 0
+            and v > 0 and G >= 0 and eta >= 0 and (G > 0 or eta > 0)
+            and math.isfinite(G + eta + sigma_c + delta + a + v)):
+        return  # a scene's valid floats, at once (the checks below cost ~1.3 us, twice a run)
     vals = dict(G=G, eta=eta, sigma_c=sigma_c, delta=delta, a=a, v=v)
     for name, x in vals.items():
         if not (isinstance(x, (int, float, np.floating, np.integer)) and math.isfinite(x)):

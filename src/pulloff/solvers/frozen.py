@@ -20,6 +20,8 @@ from .result import Result
 
 def zone_ratio(s):
     """``(b - a)/a = sqrt(1 + s^2) - 1`` without cancellation for thin zones."""
+    if type(s) is float:  # (math: the same bits without numpy's scalar arithmetic)
+        return s * s / (1.0 + math.sqrt(1.0 + s * s))
     return s * s / (1.0 + np.sqrt(1.0 + s * s))
 
 

@@ -147,7 +147,17 @@ class Span:
     def times(self, u: np.ndarray) -> np.ndarray:
         return self.start + (self.end - self.start) * u * u
 
+    def time(self, u: float) -> float:
+        """:meth:`times` of one node, in floats (the same bits)."""
+        return self.start + (self.end - self.start) * u * u
+
     def nodes(self, t: np.ndarray) -> np.ndarray:
+        """The nodes ``u`` of ascending times ``t`` (0 before ``start``)."""
+        if self.start == 0.0 and t[0] >= 0.0:
+            # (ascending times from 0: no shift, nothing to clip; the same bits in two
+            # numpy passes of the four)
+            u = t / self.end
+            return np.sqrt(u, out=u)
         return np.sqrt(np.maximum(t - self.start, 0.0) / (self.end - self.start))
 
 
@@ -214,7 +224,7 @@ def _crossing(problem: Problem, m: int, span: Span, bounded: bool, rtol: float):
         # The gap at the start within rounding of 1 where the frozen bound put it below: the
         # onset is there. (A relaxation layer before a later start only lowers the gap.)
         return span.start, 0.0, history, runs
-    lo, hi = span.times(u[j - 1:j + 1])
+    lo, hi = span.time(float(u[j - 1])), span.time(float(u[j]))
     t_coarse, slope = coarse.root_in(lo, hi, values[j - 1] - 1.0, values[j] - 1.0)
     last = j == u.size - 1
     t_fine = fine.root_near(t_coarse, slope, lo, hi, bounded and last)
@@ -235,7 +245,7 @@ def _rows(problem: Problem, run: QuadratureRun, span: Span, history, t_last: flo
     """``(t, gap)`` of the history: ``rows`` times uniform on ``[0, t_last]``, the gap from
     the interpolant, or evaluated where a row lies before the interpolant's start."""
     u, values, _ = history
-    t = np.linspace(0.0, t_last, max(2, rows))
+    t = _uniform(t_last, max(2, rows))
     gap = np.empty(t.size)
     kernels.lobatto_interpolate(u, values, span.nodes(t), gap)
     if span.start > 0.0:  # (rows start at t = 0: none lies before a span from 0)
@@ -243,6 +253,18 @@ def _rows(problem: Problem, run: QuadratureRun, span: Span, history, t_last: flo
         if np.any(early):
             gap[early] = run.gaps(t[early])
     return t, gap
+
+
+def _uniform(end: float, n: int) -> np.ndarray:
+    """``np.linspace(0.0, end, n)`` bit for bit (``n >= 2``): its ``arange * step`` with the
+    end exact, without its ~5 us of Python (its own path where the step underflows)."""
+    step = end / (n - 1)
+    if step == 0.0:
+        return np.linspace(0.0, end, n)
+    t = np.arange(n, dtype=float)
+    t *= step
+    t[-1] = end
+    return t
 
 
 def quadrature_onset(problem: Problem, t_end: float, bounded: bool, rtol: float, rows: int):
