@@ -48,7 +48,8 @@ def residual(kind, x, p0, p1, p2, coeffs):
         else:
             g = x * math.atan(x) - x * x / (1.0 + math.sqrt(1.0 + x * x))
         return g - p0, math.atan(x) + x / (1.0 + x * x) - x / math.sqrt(1.0 + x * x)
-    # the frozen gap - 1 (k, c, h0 = p0, p1, p2): frozen._frozen_gap_and_slope, whose memory
+    # the frozen gap - 1 (k, c, h0 = p0, p1, p2), as frozen.py had it in Python (the tests keep
+    # that form: test_analytic._python_frozen_onset); its memory
     # (1 - exp(-k t / c)) / k has the limits 1 / k (c = 0) and t / c (k = 0)
     k, c, h0 = p0, p1, p2
     if c == 0.0:
