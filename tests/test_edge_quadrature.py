@@ -366,3 +366,22 @@ def test_a_bond_lifted_past_its_onset_is_followed_until_its_zone_alone_grows():
     with pytest.raises(Exception, match="lifted past the onset"):
         solvers.simulate(scene_of("separation_kv", "loading.h0=6e-6",
                                   "numerics.method=stepper"))
+
+
+def test_a_rigid_path_lifted_past_its_onset_is_refused_and_an_unreached_event_is_told(tmp_path):
+    """A flat-punch path starting at ``h0`` past the onset would run on pinned in the stepper
+    (found by a review): refused with one line. Below the onset, a path whose event is not
+    reached before ``t_max`` says so (its note formatted the event's dump as a mapping and
+    crashed)."""
+    path = tmp_path / "path.yaml"
+    path.write_text(
+        "schema: 1\nname: path_kv\n"
+        "geometry: {kind: flat_punch, radius: 1.0e-5, cohesive_zone: external}\n"
+        "material: {kind: kelvin_voigt, G: 1.0e6, eta: 1.0e3}\n"
+        "adhesion: {kind: dugdale, sigma_c: 1.0e6, delta: 3.0e-6}\n"
+        "loading: {kind: path, h0: 6.0e-6, segments: [{speed: 1.0e-3, until: separation}]}\n"
+        "numerics: {rtol: 1.0e-3, t_max: 0.002}\n")
+    with pytest.raises(Exception, match=r"loading.h0 = 6e-6: lifted past the onset"):
+        load_scene(path)
+    res = solvers.simulate(load_scene(path, overrides=["loading.h0=0"]))
+    assert "until separation, which this path may never reach" in res.summary["notes"]

@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from ..model import analytic
+from ..model.loading import ConstantVelocity
 from . import levels as ladder
 from .base import Solver, problem as problem_line, stepper_settings
 from .contact_setup import FLAT_EXTERNAL, setup as make_setup
@@ -59,9 +60,18 @@ def _lifted_past_the_onset(scene) -> float | None:
     stepper's pinned bond ran on at ``a = R`` with the gap above delta (``separation_kv``
     lifted by 2 delta: no separation in 0.3 s, 1.18 N; a review in the twentieth session)."""
     loading = scene.loading
-    if (scene.geometry.kind != "flat_punch" or scene.model.until != "separation"
-            or loading.kind != "constant_velocity" or not loading.h0 > 0.0
+    if (scene.geometry.kind != "flat_punch" or not loading.h0 > 0.0
             or loading.machine_stiffness is not None):
+        return None
+    if loading.kind == "path":
+        # a rigid path that starts by lifting: the same pinned bond at t = 0 as a pull at
+        # its first speed (the gap there is the lift's and the dampers' impulse's)
+        first = loading.segments[0]
+        if loading.control != "displacement" or not (first.speed or 0.0) > 0.0:
+            return None
+        scene = scene.model_copy(update={"loading": ConstantVelocity(
+            kind="constant_velocity", v=first.speed, h0=loading.h0)})
+    elif loading.kind != "constant_velocity" or scene.model.until != "separation":
         return None
     from .edge_quadrature import EdgeModel, March  # (the gap by quadrature; one call)
     gap = March(EdgeModel.from_scene(scene), 1e-6).onset_gap(0.0)
@@ -145,7 +155,9 @@ class ContactSolver(Solver):
                 "loading.h0", scene.loading.h0, f"lifted past the onset at t = 0 (the gap at "
                 f"the zone end is {lifted:.6g} delta with the bond pinned): the contact "
                 "stepper meets the onset as the gap reaching delta from below and would run "
-                "on without it (the edge quadrature takes such pulls)"))
+                "on without it " + ("(the edge quadrature takes such pulls)"
+                                    if scene.loading.kind == "constant_velocity" else
+                                    "(start below the onset and lift with a speed segment)")))
         return out + stepper_settings(scene, "contact")
 
     def solve(self, scene, observers) -> Result:
@@ -355,9 +367,12 @@ def _notes(stepper, scene, estimate, rtol) -> list:
                 k = stepper.segment
                 until = scene.loading.segments[k].until
                 if hasattr(until, "model_dump"):
-                    until = ", ".join(f"{key} = {value:g}" if isinstance(value, float) else
-                                      f"{key} = {value}" for key, value in
-                                      until.model_dump().items() if value is not None)
+                    # (an event's target dumps to its name alone: "separation")
+                    dumped = until.model_dump()
+                    until = dumped if isinstance(dumped, str) else ", ".join(
+                        f"{key} = {value:g}" if isinstance(value, float) else
+                        f"{key} = {value}" for key, value in dumped.items()
+                        if value is not None)
                 end = (f"the end of loading.segments[{k}] (until {until}, which this path may "
                        f"never reach)")
             notes.append(f"{end} not reached before t_max = {t * s.T:.6g} s"
