@@ -514,16 +514,33 @@ def _basis(xs, i0, m, x, w, dw):
 
 @njit(cache=True)
 def _at_sigma(x, hist, i0, m, w, dw):
-    """(t, dt/dsigma, p) of the interpolant at sigma = x."""
+    """(t, dt/dsigma, p) of the interpolant at sigma = x. The times from the stencil's first
+    (the weights sum to 1, their derivatives to 0): summed from the clock since ``t = 0``,
+    ``dt/dsigma`` lost ~1e-15 of ``t`` against steps of 1e-9 on slow pulls, a relative noise
+    of up to 1e-6 in the memory's integrand (found by a review)."""
     _basis(hist[2], i0, m, x, w, dw)
+    t0 = hist[0, i0]
     t = 0.0
     dt = 0.0
     p = 0.0
     for j in range(m):
-        t += w[j] * hist[0, i0 + j]
-        dt += dw[j] * hist[0, i0 + j]
+        since = hist[0, i0 + j] - t0
+        t += w[j] * since
+        dt += dw[j] * since
         p += w[j] * hist[1, i0 + j]
-    return t, dt, p
+    return t0 + t, dt, p
+
+
+@njit(cache=True)
+def _lag(T, hist, i0, m, w):
+    """``T - t(sigma)`` of the interpolant whose basis is ``w`` (:func:`_at_sigma`), summed
+    from the nodes' own lags: ``T - sum w_j t_j`` lost ~1e-15 of ``t`` (the clock since
+    ``t = 0``, up to 2e5 creep times on slow pulls), which the memory's ``exp(-lam (T - s))``
+    magnified to ~1e-10 of the gap: noise that the secants ground on."""
+    lag = 0.0
+    for j in range(m):
+        lag += w[j] * (T - hist[0, i0 + j])
+    return lag
 
 
 @njit(cache=True)
@@ -649,31 +666,37 @@ def _history_panel(lo, hi, k, sub, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, d
     else:
         a, b = lo, hi
     width = b - a
+    # (before the onset the lag from the panel's ends: T - a, T - b are exact where close)
+    lag_a, lag_b = T - a, T - b
     tot = 0.0
     for i in range(gx.size):
         u = gx[i]
         if sub == 0:
             x = a + width * u
+            lag = lag_a - width * u
             wgt = gw[i]
         elif sub == 2:
             x = b - width * u * u
+            lag = lag_b + width * u * u
             wgt = gw[i] * 2.0 * u
         elif sub == -2:
             x = a + width * u * u
+            lag = lag_a - width * u * u
             wgt = gw[i] * 2.0 * u
         else:
             power = abs(sub)
             x = b - width * u ** power if sub > 0 else a + width * u ** power
+            lag = lag_b + width * u ** power if sub > 0 else lag_a - width * u ** power
             wgt = gw[i] * power * u ** (power - 1)
         if k >= 0:
-            s, ds, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+            _s, ds, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+            lag = _lag(T, hist, i0, m, w)
             wgt *= ds
         else:
-            s = x
-            ell = ell_of(s, rh)
+            ell = ell_of(x, rh)
             r = 0.0 if zone == 0 else ell * ell
             P = ell * ell
-        tot += wgt * creep_rate(T - s, cr) * opening(ell, r, P, ell_T, r_T, P_T)
+        tot += wgt * creep_rate(lag, cr) * opening(ell, r, P, ell_T, r_T, P_T)
     return tot * width
 
 
@@ -824,7 +847,7 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
 def _interval_from_states(k, states, rule, rules, ctx, rh, cr, hist, n, segs, deg, w, dw):
     """:func:`_history_panel` over the whole history interval ``k`` by the Gauss rule
     ``rules[rule]`` (``[points, column, distance, width, x..., weights...]`` on [0, 1]), from its
-    points' ``(s, weight, ell, r, P)``, kept in ``states[k]`` from the rule's column on (its
+    points' ``(t_k - s, weight, ell, r, P)``, kept in ``states[k]`` from the rule's column on (its
     first entry 1 once filled) the first time: an interval whose stencil holds no trial node is
     the same at every later step, so only the memory's kernel and the opening against the
     zone end are left to evaluate (the state's interpolation was ~45 % of a point's cost)."""
@@ -835,18 +858,21 @@ def _interval_from_states(k, states, rule, rules, ctx, rh, cr, hist, n, segs, de
         a = hist[2, k]
         width = hist[2, k + 1] - a
         for i in range(points):
-            s, ds, ell, r, P = _state_sigma(a + width * rules[rule, 4 + i], phase, hist, i0, m,
-                                            w, dw, rh)
+            _s, ds, ell, r, P = _state_sigma(a + width * rules[rule, 4 + i], phase, hist, i0, m,
+                                             w, dw, rh)
             j = col + 1 + 5 * i
-            row[j], row[j + 1], row[j + 2] = s, rules[rule, 4 + points + i] * ds, ell
+            # (t_k - s, from the nodes' own lags: see _lag)
+            row[j] = _lag(hist[0, k], hist, i0, m, w)
+            row[j + 1], row[j + 2] = rules[rule, 4 + points + i] * ds, ell
             row[j + 3], row[j + 4] = r, P
         row[col] = 1.0
     T, ell_T, r_T, P_T = ctx[2], ctx[3], ctx[4], ctx[5]
+    since = T - hist[0, k]
     tot = 0.0
     for i in range(points):
         j = col + 1 + 5 * i
-        tot += row[j + 1] * creep_rate(T - row[j], cr) * opening(row[j + 2], row[j + 3],
-                                                                 row[j + 4], ell_T, r_T, P_T)
+        tot += row[j + 1] * creep_rate(since + row[j], cr) * opening(row[j + 2], row[j + 3],
+                                                                     row[j + 4], ell_T, r_T, P_T)
     return tot * (hist[2, k + 1] - hist[2, k])
 
 
@@ -988,12 +1014,12 @@ def lift_step_weights(hist, first, i, rate, gx, gw, weights):
         weights[j] = 0.0
     for g in range(gx.size):
         _basis(hist[2], i0, m, lo + (hi - lo) * gx[g], basis, dbasis)
-        s = 0.0
+        lag = 0.0
         ds = 0.0
         for j in range(m):
-            s += basis[j] * hist[0, i0 + j]
-            ds += dbasis[j] * hist[0, i0 + j]
-        factor = gw[g] * (hi - lo) * ds * math.exp(-rate * (hist[0, i] - s))
+            lag += basis[j] * (hist[0, i] - hist[0, i0 + j])  # (see _lag, _at_sigma)
+            ds += dbasis[j] * (hist[0, i0 + j] - hist[0, i0])
+        factor = gw[g] * (hi - lo) * ds * math.exp(-rate * lag)
         for j in range(m):
             weights[j] += factor * basis[j]
     return m
