@@ -654,24 +654,44 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
     return q, t, sigma, False, max(step * factor, floor), accepted
 
 
-def march(run: March) -> None:
-    """The receding and zone-alone phases from the onset to separation (``run.end``)."""
-    model = run.model
-    ell_on = model.ell(run.t_on)
-    r_on = 0.0 if model.zone == 0 else ell_on ** 2
-    a_on2 = 1.0 - r_on
+def _first_phase(run: March, r_on: float):
+    """The phase the march starts in at the onset (its first node pushed), or None where the
+    punch comes off at once (``run.end = "unstable_onset"``); lifted past the onset at
+    ``t = 0``, after the jump (:func:`_jump_at_zero`)."""
+    ell_on = run.model.ell(run.t_on)
     ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
     if run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12:
         jump = _jump_at_zero(run, r_on)
         if jump is None:
             run.end = "unstable_onset"
-            return
+            return None
         ph = _Phase(2, jump[1], ph.width) if jump[0] == 2 else _Phase(3, jump[1], 0.0)
         run.t_zero = 0.0 if jump[0] == 3 else run.t_zero
     elif _unstable_onset(run, r_on):
         run.end = "unstable_onset"
-        return
+        return None
     run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase)
+    return ph
+
+
+def _ends_before_the_last_node(run: March, ph: _Phase, piece: int, t: float) -> bool:
+    """Whether the bond's end (``a -> 0`` like ``(t_end - t)^(1/3)``: a vertical tangent of
+    the branch) was solved at ``t`` within the march's error before the last node: no fold,
+    that node goes (sls_finite_punch at tolerance 2e-6: the end 9.4e-6 before a node with
+    ``a = 2.5e-3 R``, 1.5e-6 of the time unit; kept, the zone alone then turned back at
+    once). The zone alone's end is not so: it comes after its fold."""
+    n, times = run.n, run.hist[0]
+    return (ph.phase == 2 and n - 1 > piece and times[n - 2] < t < times[n - 1]
+            and times[n - 1] - t <= run.tol * run.t_unit)
+
+
+def march(run: March) -> None:
+    """The receding and zone-alone phases from the onset to separation (``run.end``)."""
+    r_on = 0.0 if run.model.zone == 0 else run.model.ell(run.t_on) ** 2
+    a_on2 = 1.0 - r_on
+    ph = _first_phase(run, r_on)
+    if ph is None:
+        return
     piece, step = 0, run.first_step
     retries, crossed = 0, False
     while True:
@@ -683,14 +703,7 @@ def march(run: March) -> None:
         if not accepted:
             continue
         p = ph.p_end if at_end else ph.p(q)
-        if (at_end and ph.phase == 2 and n - 1 > piece
-                and run.hist[0, n - 2] < t < run.hist[0, n - 1]
-                and run.hist[0, n - 1] - t <= run.tol * run.t_unit):
-            # The bond's end (a reaching 0 like (t_end - t)^(1/3): a vertical tangent of the
-            # branch) solved within the march's error before the last node: no fold, that
-            # node goes (sls_finite_punch at tolerance 2e-6: the end 9.4e-6 before a node
-            # with a = 2.5e-3 R, 1.5e-6 of the time unit; kept, the zone alone then turned
-            # back at once). The zone alone's end is not so: it comes after its fold.
+        if at_end and _ends_before_the_last_node(run, ph, piece, t):
             run.n = n = n - 1
         if (t < run.hist[0, n - 1] and retries < _FOLD_RETRIES and not at_end
                 and step > _SMALLEST_STEP * run.rounding(sigma)):
