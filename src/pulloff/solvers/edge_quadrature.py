@@ -674,17 +674,6 @@ def _first_phase(run: March, r_on: float):
     return ph
 
 
-def _ends_before_the_last_node(run: March, ph: _Phase, piece: int, t: float) -> bool:
-    """Whether the bond's end (``a -> 0`` like ``(t_end - t)^(1/3)``: a vertical tangent of
-    the branch) was solved at ``t`` within the march's error before the last node: no fold,
-    that node goes (sls_finite_punch at tolerance 2e-6: the end 9.4e-6 before a node with
-    ``a = 2.5e-3 R``, 1.5e-6 of the time unit; kept, the zone alone then turned back at
-    once). The zone alone's end is not so: it comes after its fold."""
-    n, times = run.n, run.hist[0]
-    return (ph.phase == 2 and n - 1 > piece and times[n - 2] < t < times[n - 1]
-            and times[n - 1] - t <= run.tol * run.t_unit)
-
-
 def march(run: March) -> None:
     """The receding and zone-alone phases from the onset to separation (``run.end``)."""
     r_on = 0.0 if run.model.zone == 0 else run.model.ell(run.t_on) ** 2
@@ -703,8 +692,6 @@ def march(run: March) -> None:
         if not accepted:
             continue
         p = ph.p_end if at_end else ph.p(q)
-        if at_end and _ends_before_the_last_node(run, ph, piece, t):
-            run.n = n = n - 1
         if (t < run.hist[0, n - 1] and retries < _FOLD_RETRIES and not at_end
                 and step > _SMALLEST_STEP * run.rounding(sigma)):
             # A fold persists under smaller steps; a step that overshot the branch does not.
