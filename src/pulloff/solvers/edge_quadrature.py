@@ -389,9 +389,10 @@ class _Steps(Exception):
 
 def secant(f, x0: float, h: float, xtol: float = 1e-14, patience: int = 0) -> float:
     """A root of ``f`` near ``x0`` by secants (first step ``h``), to ``xtol`` relative to
-    ``max(|x|, 1)``. With ``patience``: past :data:`_SECANTS_BEFORE_PATIENCE` secants, where
-    ``|f|`` has not fallen below its smallest value for that many in a row, ``f`` is at its
-    rounding and the point of the smallest ``|f|`` is the root (before, a march's roots are
+    ``max(|x|, 1)``. With ``patience``: from secant :data:`_SECANTS_BEFORE_PATIENCE` + 1 on,
+    where ``|f|`` (at most :data:`_RESIDUAL_NOISE`) has not fallen below its smallest value
+    for that many in a row, ``f`` is at its rounding and the point of the smallest ``|f|`` is
+    the root (before, a march's roots are
     those of plain secants: which steps turn back near a vertical tangent of ``t(sigma)`` moved
     with them, sls_finite_punch at tolerance 2e-6 falsely)."""
     f0 = f(x0)
