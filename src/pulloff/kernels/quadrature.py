@@ -604,22 +604,23 @@ def _crossing_value(which, ell, r, P, ctx):
 
 
 @njit(cache=True)
-def _crossing_at_edge(s, k, which, ctx, rh, hist, n, segs, deg, w, dw):
-    """the crossing function at an edge s of a panel on interval k (-1: before the onset)."""
+def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw):
+    """Both crossing functions (``a_s``, then ``b_s`` against ``b_T``) at an edge s of a
+    panel on interval k (-1: before the onset), from one state."""
     if k < 0:
         ell = ell_of(s, rh)
-        if int(ctx[1]) == 0:
-            return _crossing_value(which, ell, 0.0, ell * ell, ctx)
-        return _crossing_value(which, ell, ell * ell, ell * ell, ctx)
-    i0, m, phase = _stencil(k, n, segs, deg)
-    if s == hist[0, k]:
-        ell, r, P = _node_state(k, phase, hist, rh)
-    elif s == hist[0, k + 1]:
-        ell, r, P = _node_state(k + 1, phase, hist, rh)
+        r = 0.0 if int(ctx[1]) == 0 else ell * ell
+        P = ell * ell
     else:
-        x = _sigma_of(s, k, hist, i0, m, w, dw)
-        _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
-    return _crossing_value(which, ell, r, P, ctx)
+        i0, m, phase = _stencil(k, n, segs, deg)
+        if s == hist[0, k]:
+            ell, r, P = _node_state(k, phase, hist, rh)
+        elif s == hist[0, k + 1]:
+            ell, r, P = _node_state(k + 1, phase, hist, rh)
+        else:
+            x = _sigma_of(s, k, hist, i0, m, w, dw)
+            _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+    return _crossing_value(0, ell, r, P, ctx), _crossing_value(1, ell, r, P, ctx)
 
 
 @njit(cache=True)
@@ -823,17 +824,16 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
     kind = np.empty(2 * m + 8, dtype=np.int64)
     f_lo = np.empty(2)
     f_hi = np.empty(2)
-    for which in range(2):
-        f_lo[which] = _crossing_at_edge(base[first], bk[first], which, ctx, rh, hist, n, segs,
-                                        deg, w, dw)
+    f_lo[0], f_lo[1] = _crossings_at_edge(base[first], bk[first], ctx, rh, hist, n, segs, deg,
+                                          w, dw)
     c = 0
     for i in range(first, m - 1):
         lo, hi, k = base[i], base[i + 1], bk[i]
         pos[c], kidx[c], kind[c] = lo, k, -1
         c += 1
+        # (the values at hi, on this panel's interval: a join of pieces is continuous)
+        f_hi[0], f_hi[1] = _crossings_at_edge(hi, k, ctx, rh, hist, n, segs, deg, w, dw)
         for which in range(2):
-            # (the value at hi, on this panel's interval: a join of pieces is continuous)
-            f_hi[which] = _crossing_at_edge(hi, k, which, ctx, rh, hist, n, segs, deg, w, dw)
             if (f_lo[which] < 0.0) != (f_hi[which] < 0.0) and f_lo[which] != 0.0 \
                     and f_hi[which] != 0.0:
                 pos[c] = _crossing_time(lo, hi, f_lo[which], f_hi[which], k, which, ctx, rh,
