@@ -258,6 +258,7 @@ class March:
     t_origin: float = 0.0
     first_step: float = _FIRST_STEP
     t_zero: float = math.nan  # when a reached 0
+    refusal: list = field(default_factory=list)  # the stepper's lines, where it refuses
     end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
     evaluations: int = 0
@@ -279,8 +280,8 @@ class March:
         self.ctx[1] = self.model.zone
         # the history's intervals' Gauss states (kernels.history_integral), grown with it
         self.rules = _rule_table(self.gx, self.gw, self.model.fastest_rate)
-        self.states = np.zeros((256, int(self.rules[-2, 1] + 1 + 5 * self.rules[-2, 0])
-                                if len(self.rules) > 1 else 1 + 5 * self.gx.size))
+        self.states = np.zeros((256, int(max(col + 1 + 5 * points
+                                             for points, col in self.rules[:, :2]))))
 
     def sigma_of(self, t: float, q: float) -> float:
         """The march's parameter at time ``t`` and progress ``q``: ``t / t_onset + q``, or
@@ -599,9 +600,8 @@ def _jump_at_zero(run: March, r_on: float):
                 hi = start + (end - start) * k / _JUMP_SAMPLES
                 g_hi = excess(hi)
                 if g_hi <= 0.0:
-                    return phase, illinois(excess, min(lo, hi), max(lo, hi),
-                                           g_lo if lo < hi else g_hi,
-                                           g_hi if lo < hi else g_lo, 1e-15)
+                    (left, g_left), (right, g_right) = sorted(((lo, g_lo), (hi, g_hi)))
+                    return phase, illinois(excess, left, right, g_left, g_right, 1e-15)
                 lo, g_lo = hi, g_hi
         return None
     finally:
@@ -1045,11 +1045,13 @@ class EdgeQuadratureSolver(Solver):
             # separation_kv lifted by 1.5e-6 m and pulled at 1e-2 m/s, found by a review)
             if fine is None or _handed_over(fine, model, t_limit) or not estimate <= rtol:
                 from .contact import ContactSolver
-                if not ContactSolver().unsupported(scene):
+                refusal = ContactSolver().unsupported(scene)
+                if not refusal:
                     return ContactSolver().solve(scene, observers)
                 # no solver goes further (a bond lifted past its onset at t = 0 whose zone
                 # alone then grows against the face): what this one found, and why it stops
                 run = fine if fine is not None else coarse
+                run.refusal = refusal
                 return _result(scene, model, run, math.inf, coarse.evaluations + (
                     fine.evaluations if fine is not None else 0), observers,
                     time.perf_counter() - wall)
@@ -1073,11 +1075,10 @@ def _notes(run: March, scene, estimate: float) -> list:
         notes.append("the zone alone cannot hold the punch behind the machine spring where "
                      "the bond radius reaches 0: it snaps off there")
     elif run.end in ("lost", "bond_fold"):
-        from .contact import ContactSolver
         notes.append(f"no separation time: the march lost its branch at t = "
                      f"{run.hist[0, run.n - 1] * run.model.time_scale:.6g} s "
                      f"({_PHASE_NAMES[_phases(run)[-1]]}), and the contact stepper does not "
-                     "take the scene: " + "; ".join(ContactSolver().unsupported(scene)))
+                     "take the scene: " + "; ".join(run.refusal))
     elif run.end == "unstable_onset":
         notes.append("the onset is unstable (a receding edge opens the gap further): the "
                      "punch comes off at once")
