@@ -96,6 +96,18 @@ def scenes():
     # onset, the propagation's 5.5 ms, R^2.
     out["compliant_machine_k1"] = dict(out["compliant_machine"], machine_stiffness=1.0,
                                        scales=(1.4376, 5.5e-3, out["compliant_machine"]["R"] ** 2))
+    # Faces whose strength limits the bond before the rim's gap reaches delta (the zone alone
+    # then holds the whole face until the rim opens): a Kelvin-Voigt face bonded beyond its
+    # strength at t = 0 (the viscous force of the start, ell(0) = 4), a Kelvin-Voigt face that
+    # collapses after its rim opens, a standard linear solid and a Prony series whose zone
+    # folds, and a fast standard linear solid that comes off where its rim opens.
+    kv, fpi = out["separation_kv"], out["finite_punch_internal"]
+    sls, prony = out["sls_finite_punch"], out["prony_external"]
+    out["kv_face_gone_at_start"] = dict(kv, zone="internal", v=2e-2, sigma_c=1e6)
+    out["finite_punch_face"] = dict(fpi, v=2e-4, sigma_c=3.5e5)
+    out["sls_face_fold"] = dict(sls, zone="internal", v=2.7e-4, sigma_c=1.1e6)
+    out["sls_face_released"] = dict(sls, zone="internal", v=2e-2, sigma_c=6e5)
+    out["prony_face"] = dict(prony, zone="internal", v=4e-4, sigma_c=1e6)
     return out
 
 

@@ -570,6 +570,19 @@ def _sigma_of(s, k, hist, i0, m, w, dw):
 
 
 @njit(cache=True)
+def _pinned_state(s, rh, ctx):
+    """``(ell, r, P)`` at ``s`` while the bond is pinned: the zone outside (``r = 0``), or on
+    the face (``r = P = ell^2``, ``b = R``) until the face's strength limit ``ctx[6]``, from
+    which the zone alone holds the whole face (``r = P = 1``: ``a = 0``, ``b = R``)."""
+    ell = ell_of(s, rh)
+    if int(ctx[1]) == 0:
+        return ell, 0.0, ell * ell
+    if s >= ctx[6]:
+        return ell, 1.0, 1.0
+    return ell, ell * ell, ell * ell
+
+
+@njit(cache=True)
 def _node_state(j, phase, hist, rh):
     """``(ell, r, P)`` at node ``j``: ``ell`` the rigid pull's, or the history's fourth row
     behind a machine spring (where the lift is solved for with the edges)."""
@@ -608,9 +621,7 @@ def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw):
     """Both crossing functions (``a_s``, then ``b_s`` against ``b_T``) at an edge s of a
     panel on interval k (-1: before the onset), from one state."""
     if k < 0:
-        ell = ell_of(s, rh)
-        r = 0.0 if int(ctx[1]) == 0 else ell * ell
-        P = ell * ell
+        ell, r, P = _pinned_state(s, rh, ctx)
     else:
         i0, m, phase = _stencil(k, n, segs, deg)
         if s == hist[0, k]:
@@ -640,9 +651,8 @@ def _crossing_time(lo, hi, flo, fhi, k, which, ctx, rh, hist, n, segs, deg, w, d
         if not lo < x < hi:
             x = 0.5 * (lo + hi)
         if k < 0:
-            ell = ell_of(x, rh)
-            r = 0.0 if int(ctx[1]) == 0 else ell * ell
-            fx = _crossing_value(which, ell, r, ell * ell, ctx)
+            ell, r, P = _pinned_state(x, rh, ctx)
+            fx = _crossing_value(which, ell, r, P, ctx)
         else:
             _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
             fx = _crossing_value(which, ell, r, P, ctx)
@@ -659,7 +669,7 @@ def _history_panel(lo, hi, k, sub, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, d
     """Gauss over [lo, hi] (in s before the onset, in sigma on history interval k) of
     J'(T - s) opening(s, T) ds; ``sub = +-p``: a ``u^p`` substitution at the high (low) end,
     ``p = 2`` at a square root, :data:`LOG_POWER` at a logarithm (0: none)."""
-    zone, T, ell_T, r_T, P_T = int(ctx[1]), ctx[2], ctx[3], ctx[4], ctx[5]
+    T, ell_T, r_T, P_T = ctx[2], ctx[3], ctx[4], ctx[5]
     if k >= 0:
         i0, m, phase = _stencil(k, n, segs, deg)
         a = _sigma_of(lo, k, hist, i0, m, w, dw)
@@ -694,9 +704,7 @@ def _history_panel(lo, hi, k, sub, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, d
             lag = _lag(T, hist, i0, m, w)
             wgt *= ds
         else:
-            ell = ell_of(x, rh)
-            r = 0.0 if zone == 0 else ell * ell
-            P = ell * ell
+            ell, r, P = _pinned_state(x, rh, ctx)
         tot += wgt * creep_rate(lag, cr) * opening(ell, r, P, ell_T, r_T, P_T)
     return tot * width
 
@@ -769,11 +777,15 @@ def _interval_of(s, hist, n):
 
 
 @njit(cache=True)
-def _panel_edges(T, t_on, cr, hist, n, s0, pos, kidx):
-    """Panel edges in [s0, T] (sorted) and the interval of the panel each one starts."""
+def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, pos, kidx):
+    """Panel edges in [s0, T] (sorted) and the interval of the panel each one starts; the
+    face's strength limit among them where it comes before the onset."""
     c = 0
     pos[c], kidx[c] = s0, -1 if s0 < t_on else _interval_of(s0, hist, n)
     c += 1
+    if s0 < t_strength < min(T, t_on):
+        pos[c], kidx[c] = t_strength, -1
+        c += 1
     for i in range(2, cr.size, 2):
         lam = cr[i]
         if lam <= 0.0:
@@ -808,10 +820,10 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
     ``b_s = b_T`` (a log in the integrand), 0 those where ``a_s = b_T`` (a square root), -1 a
     plain edge."""
     T = ctx[2]
-    cap = 2 * n + 32
+    cap = 2 * n + 34 + DECAY_EDGES.size * (cr.size // 2)
     base = np.empty(cap)
     bk = np.empty(cap, dtype=np.int64)
-    m = _panel_edges(T, ctx[0], cr, hist, n, memory_start(T, cr), base, bk)
+    m = _panel_edges(T, ctx[0], ctx[6], cr, hist, n, memory_start(T, cr), base, bk)
     first = 0
     while first < m - 2 and base[first + 1] <= s_from:
         first += 1
@@ -829,7 +841,8 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
     c = 0
     for i in range(first, m - 1):
         lo, hi, k = base[i], base[i + 1], bk[i]
-        pos[c], kidx[c], kind[c] = lo, k, -1
+        # (the strength limit: a square root of a_s^2 = 1 - ell_s^2, on its left only)
+        pos[c], kidx[c], kind[c] = lo, k, 0 if lo == ctx[6] else -1
         c += 1
         # (the values at hi, on this panel's interval: a join of pieces is continuous)
         f_hi[0], f_hi[1] = _crossings_at_edge(hi, k, ctx, rh, hist, n, segs, deg, w, dw)
@@ -959,13 +972,10 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
 @njit(cache=True)
 def local_terms(ctx, rh, cr):
     """The instantaneous compliance's term and the Kelvin-Voigt lift step's impulse."""
-    zone, T, ell_T, r_T, P_T = int(ctx[1]), ctx[2], ctx[3], ctx[4], ctx[5]
+    T, ell_T, r_T, P_T = ctx[2], ctx[3], ctx[4], ctx[5]
     total = cr[0] * opening_now(ell_T, r_T, P_T)
     if cr[1] != 0.0:
-        r0 = 0.0
-        if zone == 1:
-            l0 = ell_of(0.0, rh)
-            r0 = l0 * l0
+        r0 = _pinned_state(0.0, rh, ctx)[1]
         Q = P_T + r0 - r_T
         if Q > 0.0:
             total += cr[1] * creep_rate(T, cr) * math.atan2(math.sqrt(Q), math.sqrt(1.0 - r0))
@@ -975,7 +985,8 @@ def local_terms(ctx, rh, cr):
 @njit(cache=True)
 def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, part, states,
                    rules):
-    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T]. part 0: the memory before
+    """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T, t_strength] (t_strength: the
+    face's strength limit, :func:`_pinned_state`; inf for none). part 0: the memory before
     s_split; 1: the rest (with the local terms); all of it: part 1 from ``-inf``. ``states``:
     the history's intervals' Gauss states, rows of ``1 + 5 gx.size`` (:func:`history_integral`).
     (One entry point: numba optimises each with its callees, so a second one for the whole

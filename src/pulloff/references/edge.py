@@ -1659,6 +1659,9 @@ class EdgeRun:
                 best_c = (Fc, float(self.T[i]))
         best_t = self._refine_peak(best_t, True)
         best_c = self._refine_peak(best_c, False)
+        if not self.external and self.km is None:
+            best_c = max(best_c, self._bonded_contact_peak(float(self.T[on])),
+                         key=lambda x: x[0])
         if "fold_state" in self.events:
             A, B, s = self.events["fold_state"]
             Fc, Ft = _forces(A, B, s, self.sigma)
@@ -1695,6 +1698,25 @@ class EdgeRun:
                                  self.sp)
         Fc, Ft = _forces(self.R2 + dA, self.R2 + dB, s, self.sigma)
         return (Ft if total else Fc), t
+
+    def _bonded_contact_peak(self, t_end):
+        """``(F, t)`` of the largest contact force ``4 sigma a s`` (``a^2 = R^2 - s^2``) of the
+        internal zone's pinned phase up to ``t_end`` under a rigid pull (its path exact):
+        where ``s = R / sqrt(2)``, or at ``t = 0`` where ``s`` is past it already. (Before a
+        face's strength limit the contact force falls back to 0; the onset's is not its
+        largest.)"""
+        half = math.sqrt(0.5 * self.R2)
+        if self._s_exact(0.0) >= half:
+            t = 0.0
+        elif self._s_exact(t_end) <= half:
+            t = t_end
+        else:
+            lo, t = 0.0, t_end
+            for _ in range(200):
+                mid = 0.5 * (lo + t)
+                lo, t = (mid, t) if self._s_exact(mid) < half else (lo, mid)
+        s = min(self._s_exact(t), math.sqrt(self.R2))
+        return _forces(self.R2 - s * s, self.R2, s, self.sigma)[0], t
 
     def _refine_peak(self, best, total):
         """Maximise the force along the interpolated path in the steps next to the best point."""

@@ -78,6 +78,21 @@ def _lifted_past_the_onset(scene) -> float | None:
     return gap if gap > 1.0 + 1e-12 else None
 
 
+def _bonded_beyond_strength(scene) -> float | None:
+    """The bonded load over the face's strength ``2 sigma_c R`` at ``t = 0`` where a rigid
+    constant-speed pull of a zone on the face needs more than that from the start (a
+    Kelvin-Voigt solid's viscous force ``v eta`` of the start, or a lift ``h0``; None
+    otherwise). The stepper found no onset there and ran to its span (``separation_kv`` on the
+    face at 2e-2 m/s: "separation not reached", where the reference comes off at 0.193 ms)."""
+    loading = scene.loading
+    if (scene.geometry.kind != "flat_punch" or scene.geometry.cohesive_zone != "internal"
+            or loading.kind != "constant_velocity" or loading.machine_stiffness is not None):
+        return None
+    from .edge_quadrature import EdgeModel
+    model = EdgeModel.from_scene(scene)
+    return model.ell(0.0) if model.t_strength == 0.0 else None
+
+
 class ContactSolver(Solver):
     """Flat punches (the zone outside or on the face) pulled to separation, and any
     rheology, behind a rigid machine or a spring."""
@@ -158,6 +173,12 @@ class ContactSolver(Solver):
                 "on without it " + ("(the edge quadrature takes such pulls)"
                                     if scene.loading.kind == "constant_velocity" else
                                     "(start below the onset and lift with a speed segment)")))
+        beyond = _bonded_beyond_strength(scene)
+        if beyond is not None:
+            out.append(problem_line(
+                "loading.v", scene.loading.v, f"the bond needs {beyond:.6g} times the face's "
+                "strength at t = 0: the contact stepper finds no onset there (the edge "
+                "quadrature takes such pulls to separation)"))
         return out + stepper_settings(scene, "contact")
 
     def solve(self, scene, observers) -> Result:

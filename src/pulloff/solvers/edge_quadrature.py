@@ -154,6 +154,7 @@ class EdgeModel:
     rh: np.ndarray  # the bonded load's law (kernels.ell_of)
     cr: np.ndarray  # the creep compliance (kernels.creep_rate)
     machine: Machine | None = None  # a machine spring's (None: a rigid pull)
+    t_strength: float = math.inf  # when a zone on the face reaches its strength limit
 
     @classmethod
     def from_scene(cls, scene, t_limit: float = math.inf) -> "EdgeModel":
@@ -176,8 +177,10 @@ class EdgeModel:
         if scene.loading.machine_stiffness is not None:
             machine = Machine.from_scene(scene, t_limit)
             rh = machine.law_array()
-        return cls(R, sigma_c, delta, v, h0, 0 if scene.geometry.cohesive_zone == "external"
-                   else 1, ts, np.array(rh, float), np.array(cr, float), machine)
+        model = cls(R, sigma_c, delta, v, h0, 0 if scene.geometry.cohesive_zone == "external"
+                    else 1, ts, np.array(rh, float), np.array(cr, float), machine)
+        model.t_strength = strength_time(model, math.inf)
+        return model
 
     @property
     def fastest_rate(self) -> float:
@@ -208,8 +211,10 @@ class EdgeModel:
         """``(ell, r, P)`` at ``t``: phase 1 pinned, 2 receding (``p = r``), 3 alone
         (``p = b^2``); ``ell`` given past the onset behind a machine spring."""
         ell = self.ell(t) if ell is None else ell
-        if phase == 1:
-            return (ell, 0.0, ell * ell) if self.zone == 0 else (ell, ell * ell, ell * ell)
+        if phase == 1:  # (as kernels._pinned_state)
+            if self.zone == 0:
+                return ell, 0.0, ell * ell
+            return (ell, 1.0, 1.0) if t >= self.t_strength else (ell, ell * ell, ell * ell)
         return (ell, p, ell * ell) if phase == 2 else (ell, 1.0, p)
 
     def radii(self, t: float, p: float, phase: int, ell: float | None = None):
@@ -259,6 +264,7 @@ class March:
     first_step: float = _FIRST_STEP
     t_zero: float = math.nan  # when a reached 0
     refusal: list = field(default_factory=list)  # the stepper's lines, where it refuses
+    released: bool = False  # the zone alone from a face at its strength limit: its first piece
     end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
     evaluations: int = 0
@@ -276,8 +282,8 @@ class March:
         self.lifts = np.zeros(MAX_NODES + 2)  # behind a machine spring: H at the nodes
         self.zero = ()  # behind a machine spring: (t, H, ell) where a reached 0
         self.segs = np.zeros((0, 2), dtype=np.int64)
-        self.ctx = np.zeros(6)
-        self.ctx[1] = self.model.zone
+        self.ctx = np.zeros(7)
+        self.ctx[1], self.ctx[6] = self.model.zone, self.model.t_strength
         # the history's intervals' Gauss states (kernels.history_integral), grown with it
         self.rules = _rule_table(self.gx, self.gw, self.model.fastest_rate)
         self.states = np.zeros((256, int(max(col + 1 + 5 * points
@@ -508,7 +514,10 @@ def _step(run: March, ph: _Phase, sigma: float, q_guess: float, piece: int) -> t
 
 
 def _predict(run: March, piece: int, sigma: float, values: np.ndarray) -> float:
-    m = min(run.n - piece, DEGREE + 1)
+    # (a zone alone released from the face leaves its first node like e log e: that node is
+    # left out once two others are there, see _RELEASE_GROWTH)
+    first = piece + 1 if run.released and piece == 0 and run.n > 2 else piece
+    m = min(run.n - first, DEGREE + 1)
     return kernels.lagrange(run.hist[2], values, run.n - m, m, sigma)
 
 
@@ -563,15 +572,73 @@ def _land_on_kink(run: March, ph: _Phase, piece: int, sigma: float, before: floa
     return q, t, s
 
 
-def _unstable_onset(run: March, r_on: float) -> bool:
-    """Whether a receding edge would open the gap further at the onset (an elastic solid's
-    crack runs at once): the gap's slope in ``r`` at the onset's time."""
-    width = run.model.ell(run.t_on) ** 2
-    dr = 1e-6 * width
-    run.push(run.t_on, r_on, 0.0, 0.0, new_piece=2)
-    g = run.gap(run.t_on, r_on + dr, 2, 1e-9 * dr / width)
+def _unstable_onset(run: March, ph: "_Phase") -> bool:
+    """Whether the first phase's edge moving on would open the gap further at the onset (an
+    elastic solid's crack runs at once): the gap's slope in the phase's measure at the
+    onset's time; from a face released at its rim, :func:`_lets_go_at_release`."""
+    if ph.phase == 3:
+        return _lets_go_at_release(run)
+    dr = 1e-6 * ph.width
+    run.push(run.t_on, ph.p0, 0.0, 0.0, new_piece=2)
+    g = run.gap(run.t_on, ph.p0 + dr, 2, 1e-9 * dr / ph.width)
     run.n, run.segs = 0, run.segs[:0]
     return g > 1.0 + 1e-12
+
+
+#: The growth of the first steps of a zone alone released from a face at its strength limit
+#: (2 elsewhere): it leaves the release like ``t - t_release ~ e (A - c1 log e)`` in its shrunk
+#: area ``e = 1 - b^2 / R^2`` (:func:`_lets_go_at_release`), and the degree-5 interpolants
+#: through first nodes a factor 2 apart (a stencil spanning 32x in ``e``) did not hold that
+#: log: the first predicted step missed its slope by O(1), the steps fell to the rounding and
+#: the march turned back falsely within 1e-5 of the time (tolerances 1e-8, 1e-9 on Kelvin-Voigt
+#: and Prony faces, 1e-7 on a Kelvin-Voigt face at 2.2e-5 m/s; marches agreeing). With 1.1, and
+#: the release's node left out of the predictor, five faces of the reference and the
+#: Kelvin-Voigt face at 2.2e-4 and 2.2e-5 m/s run through at tolerances 1e-5 to 1e-8 (errors
+#: 5e-12 to 1.4e-7 against the reference), at 1e-9 all but one (/tmp study, 22nd session).
+_RELEASE_GROWTH = 1.1
+#: Nodes after such a release within which a turn back in time is no fold but a lost branch
+#: (handed over): with the first steps' growth 1.1 a Kelvin-Voigt face at 2.2e-5 m/s still
+#: turned back at its 10th node at tolerance 1e-9 (the first predicted step's slope 2e-3 off,
+#: the steps cut to the rounding), 2 % before the collapse the coarser marches and the
+#: reference find; a fold within the dip of the release itself is found apart
+#: (:func:`_lets_go_at_release`).
+_RELEASE_NODES = 40
+#: The zone alone released from a face at its strength limit: the decades of ``1 - b^2``
+#: sampled for the gap's dip below delta (:func:`_lets_go_at_release`), the first the
+#: largest shrinkage at which the gap must have opened for the fold to lie within the dip.
+_RELEASE_DECADES = range(3, 15)
+
+
+def _lets_go_at_release(run: March) -> bool:
+    """Whether a zone alone on the whole face comes off right where its rim opens (``b = R``,
+    ``gap = delta`` at ``run.t_on``); then ``run.fold`` = ``(t, nan)`` of the fold. The gap
+    of a smaller zone goes like ``e (c0 + c1 log e)`` in ``e = 1 - b^2`` (the elements at the
+    rim carried sigma_c since the strength limit: the ``d log d`` of the zone's opening), so
+    it first dips below delta, by ~1e-9 on a standard linear solid at 2e-2 m/s, before it
+    opens. Where it has opened by ``e = 1e-3``, the branch turns back within the dip: the
+    fold comes when the rim's gap has risen by the dip's depth, ``depth / (d gap / dt)``
+    after the release (to first order in the dip's width: the rate is that of ``e = 0``)."""
+    t = run.t_on
+    run.push(t, 1.0, 0.0, 0.0, new_piece=3)
+    try:
+        def excess(log_e):
+            return run.gap(t, 1.0 - 10.0 ** log_e, 3, 1e-12) - 1.0
+
+        if not excess(-_RELEASE_DECADES[0]) > 0.0:
+            return False
+        samples = [(excess(-k), -k) for k in _RELEASE_DECADES]
+        depth, k = min(samples)
+        if depth < 0.0:
+            lo, hi = k - 1.0, min(k + 1.0, -float(_RELEASE_DECADES[0]))
+            depth = min(depth, excess(_largest(lambda x: -excess(x), lo, hi, 1e-3)))
+        dt = 1e-9 * max(t, run.t_unit)
+        rate = (run.gap(t + dt, 1.0, 3, 1e-12) - 1.0) / dt
+        if not rate > 0.0:
+            return False
+        run.fold = (t + max(-depth, 0.0) / rate, math.nan)
+        return True
+    finally:
+        run.n, run.segs = 0, run.segs[:0]
 
 
 #: Samples of each phase's measure in the search for the state a bond lifted past its onset
@@ -589,9 +656,11 @@ def _jump_at_zero(run: March, r_on: float):
     alone, closes the gap: a Kelvin-Voigt punch lifted by ``2 delta`` keeps ``a = 0.2 R``;
     an elastic solid follows at once and opens further (off at once, as the reference)."""
     run.push(0.0, r_on, 0.0, 0.0, new_piece=2)
-    b0 = run.model.ell(0.0) ** 2
+    b0 = run.model.state(0.0, 0.0, 1)[2]  # (b^2 where a reaches 0: the face's at most)
     try:
         for phase, start, end in ((2, r_on, 1.0), (3, b0, 0.0)):
+            if start == end:  # (a face at its strength limit: no bond to recede)
+                continue
             def excess(p, phase=phase):
                 return run.gap(0.0, p, phase, 0.0) - 1.0
 
@@ -648,7 +717,8 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
             return None
         return q, t, sigma, False, 0.25 * step, False
     if n - piece <= DEGREE:
-        return q, t, sigma, False, 2.0 * step, True
+        growth = _RELEASE_GROWTH if run.released and piece == 0 else 2.0
+        return q, t, sigma, False, growth * step, True
     miss = _miss(run, ph, q, q_guess, t)
     factor = min(2.0, max(0.2, 0.8 * (run.tol / max(miss, 1e-300)) ** (1.0 / (DEGREE + 1))))
     accepted = not (miss > 3.0 * run.tol and step > floor)
@@ -658,9 +728,13 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
 def _first_phase(run: March, r_on: float):
     """The phase the march starts in at the onset (its first node pushed), or None where the
     punch comes off at once (``run.end = "unstable_onset"``); lifted past the onset at
-    ``t = 0``, after the jump (:func:`_jump_at_zero`)."""
+    ``t = 0``, after the jump (:func:`_jump_at_zero`); from a face held at its strength limit
+    (``a = 0`` at the onset), the zone alone from ``b = R``."""
     ell_on = run.model.ell(run.t_on)
-    ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
+    if r_on >= 1.0:
+        ph = _Phase(3, 1.0, 0.0)
+    else:
+        ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
     if run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12:
         jump = _jump_at_zero(run, r_on)
         if jump is None:
@@ -668,16 +742,19 @@ def _first_phase(run: March, r_on: float):
             return None
         ph = _Phase(2, jump[1], ph.width) if jump[0] == 2 else _Phase(3, jump[1], 0.0)
         run.t_zero = 0.0 if jump[0] == 3 else run.t_zero
-    elif _unstable_onset(run, r_on):
+    elif _unstable_onset(run, ph):
         run.end = "unstable_onset"
         return None
+    if ph.phase == 3 and math.isnan(run.t_zero):
+        run.t_zero = min(run.t_on, run.model.t_strength)
+    run.released = ph.phase == 3 and r_on >= 1.0
     run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase)
     return ph
 
 
 def march(run: March) -> None:
     """The receding and zone-alone phases from the onset to separation (``run.end``)."""
-    r_on = 0.0 if run.model.zone == 0 else run.model.ell(run.t_on) ** 2
+    r_on = run.model.state(run.t_on, 0.0, 1)[1]
     a_on2 = 1.0 - r_on
     ph = _first_phase(run, r_on)
     if ph is None:
@@ -700,13 +777,16 @@ def march(run: March) -> None:
             retries += 1
             continue
         if t < run.hist[0, n - 1]:
-            if n - piece <= DEGREE or (ph.phase == 3 and crossed):
+            first = _RELEASE_NODES if run.released and piece == 0 else DEGREE
+            if n - piece <= first or (ph.phase == 3 and crossed):
                 # Turned back within a phase's first steps (the seed scene's zone alone at
                 # tolerance 1e-7, where finer and coarser marches collapse), or after the
                 # zone alone passed the onset's bond radius (separation_kv lifted by 1.5e-6 m
                 # at 1e-2 m/s, at tolerance 1e-6 only, 1.6 % before the reference's collapse;
                 # every real fold met so far, the zone's on the face and outside, came
-                # before any such crossing of the zone alone): no fold this march can place
+                # before any such crossing of the zone alone), or within a zone alone's
+                # first steps after the face released it (_RELEASE_NODES): no fold this
+                # march can place
                 run.end = "lost"
                 return
             run.push(t, p, sigma, q)
@@ -746,14 +826,14 @@ def march(run: March) -> None:
         step = run.first_step
 
 
-def _largest(f, lo: float, hi: float) -> float:
+def _largest(f, lo: float, hi: float, xtol: float = 0.0) -> float:
     """The argument of the largest ``f`` in ``[lo, hi]`` (golden section; ``f`` unimodal
-    there)."""
+    there), to ``xtol`` (or the rounding of ``hi``)."""
     golden = 0.5 * (math.sqrt(5.0) - 1.0)
     a, b = lo + (1 - golden) * (hi - lo), lo + golden * (hi - lo)
     fa, fb = f(a), f(b)
     for _ in range(200):
-        if hi - lo <= 1e-15 * abs(hi):
+        if hi - lo <= max(1e-15 * abs(hi), xtol):
             break
         if fa > fb:
             hi, b, fb = b, a, fa
@@ -828,7 +908,9 @@ def _onset_contact_peak(run: March) -> tuple:
     at ``ell^2 = 1/2``."""
     model = run.model
     t = run.t_on
-    if model.zone == 1 and model.ell(t) ** 2 > 0.5:
+    if model.zone == 1 and model.ell(0.0) ** 2 >= 0.5:
+        t = 0.0
+    elif model.zone == 1 and model.ell(t) ** 2 > 0.5:
         lo, hi = 0.0, t
         for _ in range(200):
             mid = 0.5 * (lo + hi)
@@ -843,7 +925,9 @@ def summarise(run: March) -> dict:
     out = {"detached": math.isfinite(run.t_on)}
     if not out["detached"]:
         return out
-    t = run.t_on
+    # the bond lets go at the onset, or where the face's strength limit comes first (the
+    # zone alone then holds the face until its rim opens, at run.t_on)
+    t = min(run.t_on, model.t_strength)
     a, b = model.radii(t, 0.0, 1)
     Fc, Ft = model.forces(t, 0.0, 1)
     h_on = (model.h0 + model.v * t * ts if model.machine is None
@@ -852,8 +936,10 @@ def summarise(run: March) -> dict:
                zone_ratio_detach=(b - a) / a if a > 0.0 else math.nan, F_contact_detach=Fc,
                F_total_detach=Ft)
     if run.end == "unstable_onset":
-        out.update(t_separation=t * ts, F_peak_total=Ft, t_peak_total=t * ts,
-                   F_peak_contact=Fc, t_peak_contact=t * ts)
+        tc, Fcp = _onset_contact_peak(run)
+        t_off = run.fold[0] if run.fold else run.t_on  # (a zone alone's fold in its dip)
+        out.update(t_separation=t_off * ts, F_peak_total=Ft, t_peak_total=t * ts,
+                   F_peak_contact=Fcp, t_peak_contact=tc * ts)
         return out
     if run.end in ("collapse", "fold", "snap"):
         out["t_separation"] = (run.fold[0] if run.end == "fold" else run.hist[0, run.n - 1]) * ts
@@ -878,6 +964,8 @@ def history(run: March) -> dict:
     # (one row where the onset is at t = 0: the pinned state, before a jump)
     times = np.linspace(0.0, t_first, ONSET_ROWS + 1)[:-1 if run.n else None] if t_first > 0.0 \
         else np.zeros(1)
+    if 0.0 < model.t_strength < t_first:  # (the row where the bond is gone)
+        times = np.sort(np.append(times, model.t_strength))
     for t in times:
         rows.append((t, 0.0, 1, run.onset_gap(t), None, None if rigid else model.lift(t)))
     phases = _phases(run)
@@ -945,7 +1033,6 @@ def _time_unit(model: EdgeModel, t_on: float) -> float:
 def run_at(model: EdgeModel, tol: float, t_limit: float) -> March:
     """One run: the onset, then the march (``run.end`` says how it ended)."""
     run = March(model, tol, t_limit)
-    run.t_limit = min(t_limit, strength_time(model, t_limit))
     if model.machine is not None:  # (its lift path holds the onset: machine_lift)
         run.t_limit = min(run.t_limit, model.machine.span)
     find_onset(run)
@@ -968,19 +1055,26 @@ def run_at(model: EdgeModel, tol: float, t_limit: float) -> March:
     return run
 
 
-def _handed_over(run: March, model: EdgeModel, t_limit: float) -> bool:
+def _handed_over(run: March) -> bool:
     """Whether a run ended where this solver gives no answer and the contact stepper takes the
-    scene: the face's strength limit before the onset (the zone alone then holds the face, a
-    phase this march does not have), a branch turning back while the bond holds, or a lost
-    branch. A fold of the bond can be real (a standard linear solid pulled at 1e-2 m/s with
-    its zone outside snaps 34 us after its onset, as the reference finds) or false: slow
-    pulls turned back near their onset at every tolerance until the march's time unit was
-    capped (:data:`_CREEP_TIMES`), and at tolerances near 1e-8 until the step floor was
-    measured against the onset time in that unit (:meth:`March.rounding`; a standard linear
-    solid at 1e-7 m/s, rtol 1e-8: two marches had agreed on a fold 1.3 s before the
-    separation). The march cannot tell a false fold from a real one."""
-    return (run.end == "no_onset" and strength_time(model, t_limit) < t_limit
-            or run.end in ("bond_fold", "lost"))
+    scene: a branch turning back while the bond holds, or a lost branch. A fold of the bond
+    can be real (a standard linear solid pulled at 1e-2 m/s with its zone outside snaps 34 us
+    after its onset, as the reference finds) or false: slow pulls turned back near their
+    onset at every tolerance until the march's time unit was capped
+    (:data:`_CREEP_TIMES`), and at tolerances near 1e-8 until the step floor was measured
+    against the onset time in that unit (:meth:`March.rounding`; a standard linear solid at
+    1e-7 m/s, rtol 1e-8: two marches had agreed on a fold 1.3 s before the separation). The
+    march cannot tell a false fold from a real one."""
+    return run.end in ("bond_fold", "lost")
+
+
+def _release_offset(run: March) -> float:
+    """Where a zone alone comes off within its dip just after its rim opens
+    (:func:`_lets_go_at_release`): that fold's distance from the release, relative to it, a
+    bound on the error of its first-order time (0 elsewhere)."""
+    if run.end != "unstable_onset" or not run.fold:
+        return 0.0
+    return (run.fold[0] - run.t_on) / run.fold[0]
 
 
 class EdgeQuadratureSolver(Solver):
@@ -1033,7 +1127,7 @@ class EdgeQuadratureSolver(Solver):
         with observers.progress("edge quadrature", None):
             coarse = run_near(model, _TOL_PER_RTOL * rtol, t_limit)
             fine = None
-            if not _handed_over(coarse, model, t_limit):
+            if not _handed_over(coarse):
                 fine = run_near(model, coarse.tol / _CHECK, t_limit)
                 estimate = _changes(summarise(coarse), summarise(fine))
                 while (estimate > rtol and fine.tol > 1e-3 * rtol
@@ -1043,7 +1137,7 @@ class EdgeQuadratureSolver(Solver):
             # Two marches that do not agree within rtol are no answer either (a zone alone
             # passing the onset's bond radius turned back there at some tolerances:
             # separation_kv lifted by 1.5e-6 m and pulled at 1e-2 m/s, found by a review)
-            if fine is None or _handed_over(fine, model, t_limit) or not estimate <= rtol:
+            if fine is None or _handed_over(fine) or not estimate <= rtol:
                 from .contact import ContactSolver
                 refusal = ContactSolver().unsupported(scene)
                 if not refusal:
@@ -1057,6 +1151,7 @@ class EdgeQuadratureSolver(Solver):
                     time.perf_counter() - wall)
         if model.machine is not None:  # (both marches share the lift path before the onset)
             estimate += model.machine.path_error
+        estimate = max(estimate, _release_offset(fine))
         return _result(scene, model, fine, estimate, coarse.evaluations + fine.evaluations,
                        observers, time.perf_counter() - wall)
 
@@ -1079,6 +1174,11 @@ def _notes(run: March, scene, estimate: float) -> list:
                      f"{run.hist[0, run.n - 1] * run.model.time_scale:.6g} s "
                      f"({_PHASE_NAMES[_phases(run)[-1]]}), and the contact stepper does not "
                      "take the scene: " + "; ".join(run.refusal))
+    elif run.end == "unstable_onset" and run.model.t_strength < run.t_on:
+        ts = run.model.time_scale
+        notes.append(f"the face held at its strength limit from t = {run.model.t_strength * ts:.6g}"
+                     f" s comes off where its rim opens (t = {run.t_on * ts:.6g} s): a smaller "
+                     "zone alone opens the gap further")
     elif run.end == "unstable_onset":
         notes.append("the onset is unstable (a receding edge opens the gap further): the "
                      "punch comes off at once")
