@@ -335,6 +335,20 @@ def test_the_stepper_refuses_a_face_bonded_beyond_its_strength_at_the_start():
     assert solvers.route(scene_of("kv_face_gone_at_start")).name == "edge_quadrature"
 
 
+def test_a_check_run_out_of_nodes_leaves_the_coarser_answer_without_an_estimate(monkeypatch):
+    """A check march gets at most 4x its coarser march's nodes (+200): at the rtol floor a
+    slow Kelvin-Voigt face's check crept on at the gap's rounding towards 20000 nodes (minutes).
+    Then the coarser march is the answer, with no estimate and a note saying why (here the
+    cap is forced low)."""
+    monkeypatch.setattr(edge, "_check_nodes", lambda run: 20)
+    res = solvers.simulate(scene_of("finite_punch_face", "numerics.rtol=1e-4"))
+    assert res.summary["solver"] == "edge_quadrature" and math.isinf(res.error_estimate)
+    assert ("no error estimate: the check run at tolerance 0.0002 stopped after 20 nodes"
+            in res.summary["notes"])
+    assert res.t_separation == pytest.approx(REFERENCE["finite_punch_face"]["t_separation"],
+                                             rel=1e-5)
+
+
 # ------------------------------------------------------------------ the far intervals' rules
 @pytest.mark.parametrize("points", edge._FAR_POINTS)
 def test_a_far_rule_meets_its_exponential_bound_at_its_longest_interval(points):
