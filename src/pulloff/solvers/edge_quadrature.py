@@ -5,7 +5,8 @@ two radii (:func:`pulloff.kernels.quadrature.edge_gap_split`: the spatial part i
 form). The history is what is solved for:
 
 - **onset** (``a`` pinned at ``R`` with the zone outside, or ``b`` pinned at ``R`` with the
-  zone on the face): explicit, the onset is the root of ``gap = delta`` in time;
+  zone on the face, and there from the face's strength limit on ``a = 0``: the zone alone on
+  the whole face): explicit, the onset is the root of ``gap = delta`` in time;
 - **receding** (both move, the edge condition ``b^2 = a^2 + ell^2`` holds): unknown ``a(t)``;
 - **zone alone** (``a = 0``): unknown ``b(t)``, until it collapses (``b -> 0``) or the branch
   turns back in time (a fold: the punch snaps off).
