@@ -349,6 +349,69 @@ def test_a_check_run_out_of_nodes_leaves_the_coarser_answer_without_an_estimate(
                                              rel=1e-5)
 
 
+def test_a_lifted_face_bonded_beyond_its_strength_at_the_start_comes_off_on_the_quadrature():
+    """A standard linear solid on the face lifted by 1e-6 m needs 2x the face's strength at
+    t = 0 (its instantaneous modulus); its bonded load then relaxes below the limit and rises
+    again. The strength limit is t = 0 (it was taken at the later rise, 40 s, with a pinned
+    bond of b = 2 R before it: a nan gap). The rim opens at 51.83 s and the zone alone folds
+    60 ms later: rtol 1e-3 and 1e-4 within 6.0e-7, 5.1e-7 of rtol 1e-6 (estimates 1.8e-7,
+    8.7e-7;
+    the coarse marches had landed on the collapse over the fold, and at rtol 1e-3 the first
+    march's nodes oscillated into a zone larger than the face)."""
+    runs = {rtol: solvers.simulate(scene_of("sls_finite_punch", *FACE, "adhesion.sigma_c=1e6",
+                                            "loading.v=1e-7", "loading.h0=1e-6",
+                                            f"numerics.rtol={rtol}"))
+            for rtol in (1e-3, 1e-4, 1e-6)}
+    fine = runs[1e-6]
+    assert fine.summary["solver"] == "edge_quadrature" and fine.t_detach == 0.0
+    assert fine.F_peak_total == pytest.approx(math.pi * 1e-10 * 1e6, rel=1e-14)
+    assert 51.97 < fine.t_separation < 51.971
+    for rtol in (1e-3, 1e-4):
+        error = abs(runs[rtol].t_separation / fine.t_separation - 1.0)
+        assert error <= rtol and runs[rtol].error_estimate >= 0.1 * error
+        assert runs[rtol].F_peak_total <= math.pi * 1e-10 * 1e6 * (1 + 1e-14)
+
+
+def test_a_zone_alone_turning_back_just_before_its_collapse_is_a_fold_at_coarse_tolerances():
+    """A Prony face at 1.81e-5 m/s folds at b^2 ~ 1e-2 b_0^2, just before it would collapse.
+    The coarse marches (rtol 1e-4) landed on the collapse from b^2 = 0.1 b_0^2 and agreed with
+    each other: 1.0e-4 early, estimate 1.3e-5 (a review). The branch is now solved between
+    such a landing and the last node first (edge._turns_before_the_end)."""
+    coarse, fine = (solvers.simulate(scene_of(
+        "prony_external", *FACE, "loading.v=1.811e-5", "adhesion.sigma_c=4.89e5",
+        f"numerics.rtol={rtol}")) for rtol in (1e-4, 1e-6))
+    error = abs(coarse.t_separation / fine.t_separation - 1.0)
+    assert error < 1e-5 and coarse.error_estimate >= 0.1 * error
+    assert fine.t_separation == pytest.approx(0.2627738, rel=1e-6)
+
+
+def test_a_fast_prony_face_folding_soon_after_its_release_stays_on_the_quadrature():
+    """At 4.2e-2 m/s a Prony face's zone alone folds 25-37 nodes after its rim opens; those
+    turns were taken for the rounding's and handed to the stepper. Against the stepper
+    (rtol 1e-5: 8.05641970063e-5 s, its estimate 2.6e-7): 2e-9."""
+    res = solvers.simulate(scene_of("prony_external", *FACE, "loading.v=0.04209",
+                                    "adhesion.sigma_c=9.505e5", "numerics.rtol=1e-6"))
+    assert res.summary["solver"] == "edge_quadrature"
+    assert res.t_separation == pytest.approx(8.05641970063e-5, rel=3e-7)
+
+
+def test_t_max_between_the_strength_limit_and_the_rims_opening_is_said():
+    """The face lets go of its bond at its strength limit (7.75 ms): a t_max after that but
+    before the rim opens (22 ms) reports the detachment with the strength limit's force and
+    no separation, with a note (it reported no detachment at all)."""
+    res = solvers.simulate(scene_of("finite_punch_face", "numerics.t_max=0.0141602"))
+    assert res.summary["detached"] and res.t_detach == pytest.approx(7.75e-3, rel=1e-12)
+    assert res.F_total_detach == pytest.approx(math.pi * 1e-10 * 3.5e5, rel=1e-14)
+    assert math.isnan(res.t_separation) and "did not open before t_max" in res.summary["notes"]
+    assert res.F_peak_contact == pytest.approx(2 * 3.5e5 * 1e-10, rel=1e-12)
+
+
+def test_a_face_behind_a_machine_spring_has_no_strength_time_to_find():
+    model = edge.EdgeModel.from_scene(load_scene(CONFIGS / "compliant_machine.yaml", overrides=[
+        "geometry.cohesive_zone=internal", "model.until=separation"]))
+    assert model.t_strength == math.inf
+
+
 # ------------------------------------------------------------------ the far intervals' rules
 @pytest.mark.parametrize("points", edge._FAR_POINTS)
 def test_a_far_rule_meets_its_exponential_bound_at_its_longest_interval(points):

@@ -177,8 +177,7 @@ class ContactSolver(Solver):
         if beyond is not None:
             out.append(problem_line(
                 "loading.v", scene.loading.v, f"the bond needs {beyond:.6g} times the face's "
-                "strength at t = 0: the contact stepper finds no onset there (the edge "
-                "quadrature takes such pulls to separation)"))
+                "strength at t = 0: the contact stepper finds no onset there"))
         return out + stepper_settings(scene, "contact")
 
     def solve(self, scene, observers) -> Result:

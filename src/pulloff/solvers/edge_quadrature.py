@@ -78,6 +78,39 @@ _SECANTS_BEFORE_PATIENCE = 8
 _RESIDUAL_NOISE = 1e-10
 #: The smallest step, relative to sigma (where the predictor's miss is rounding).
 _SMALLEST_STEP = 1e-11
+#: Where the zone alone would land on its collapse (``b = 0``) from a node farther than this
+#: in ``q = 1 - b^2 / b_0^2``, its branch is first solved at a few points between
+#: (:func:`_turns_before_the_end`). It may turn back just before the collapse (a fold at
+#: ``b^2`` ~ 1e-2 ``b_0^2``): marches of rtol 1e-4 that had landed from ``b^2 = 0.1 b_0^2`` on
+#: standard linear solid and Prony faces (1.2e-4, 1.8e-5 m/s) came out 1e-4 and 3.9e-4
+#: early, with estimates 8x below that (a review).
+_LANDING_GAP = 1e-3
+_LANDING_CHECKS = 4
+
+
+def _turns_before_the_end(run: March, ph: _Phase, t_end: float) -> bool:
+    """Whether the branch between the last node and the collapse found at ``t_end`` reaches
+    a later time than that somewhere (a fold first): its time solved at fixed ``b`` where
+    ``1 - q`` is halved from the last node's, :data:`_LANDING_CHECKS` times (landings from
+    within :data:`_LANDING_GAP` are not checked)."""
+    n = run.n
+    left = ph.q_end - run.qs[n - 1]
+    if left <= _LANDING_GAP:
+        return False
+    t0 = run.hist[0, n - 1]
+    for k in range(1, _LANDING_CHECKS + 1):
+        q = ph.q_end - left * 0.5 ** k
+        t = secant(lambda s: run.gap(s, ph.p(q), ph.phase, run.sigma_of(s, q)) - 1.0, t0,
+                   1e-9 * t0, 1e-11)
+        if not math.isfinite(t):
+            return False
+        if t > t_end:
+            return True
+        t0 = t
+    return False
+#: The zone alone's ``1 - q`` (its ``b^2`` over the phase's first) within which a collapse
+#: whose landing fails is taken at the last node's time, extrapolated.
+_COLLAPSED = 1e-6
 #: Quartered steps before a step back in time is taken for a fold.
 _FOLD_RETRIES = 6
 #: The march's time unit in creep times at most (:func:`_time_unit`). With the onset time
@@ -180,7 +213,7 @@ class EdgeModel:
             rh = machine.law_array()
         model = cls(R, sigma_c, delta, v, h0, 0 if scene.geometry.cohesive_zone == "external"
                     else 1, ts, np.array(rh, float), np.array(cr, float), machine)
-        model.t_strength = strength_time(model, math.inf)
+        model.t_strength = strength_time(model)
         return model
 
     @property
@@ -266,6 +299,7 @@ class March:
     t_zero: float = math.nan  # when a reached 0
     refusal: list = field(default_factory=list)  # the stepper's lines, where it refuses
     released: bool = False  # the zone alone from a face at its strength limit: its first piece
+    smallest: float = math.inf  # the smallest step taken (in sigma)
     max_nodes: int = MAX_NODES
     end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
@@ -468,10 +502,18 @@ def find_onset(run: March) -> None:
     run.t_on = illinois(lambda s: run.onset_gap(s) - 1.0, lo, t, g_lo, g, 4e-16 * t)
 
 
-def strength_time(model: EdgeModel, t_limit: float) -> float:
-    """When the bonded load of a zone on the face reaches ``2 sigma_c R`` (inf if never before
-    ``t_limit``): the bond would then need more than the whole face can hold."""
-    if model.zone == 0 or model.ell(t_limit if math.isfinite(t_limit) else 1e300) < 1.0:
+def strength_time(model: EdgeModel) -> float:
+    """When the bonded load of a zone on the face first reaches ``2 sigma_c R`` (inf if never):
+    the bond would then need more than the whole face can hold. 0 where it needs that at
+    ``t = 0`` already (a lift ``h0`` or a Kelvin-Voigt solid's dampers), also where ``ell``
+    then relaxes below 1 for a while (a lifted standard linear solid): the bond is gone at
+    once. (``ell`` of a rigid pull falls, if at all, only from ``t = 0`` to one minimum, so
+    from ``ell(0) < 1`` the first crossing is on its rise, which doubling brackets.)"""
+    if model.zone == 0 or model.machine is not None:
+        return math.inf
+    if model.ell(0.0) >= 1.0:
+        return 0.0
+    if model.ell(1e300) < 1.0:
         return math.inf
     lo, hi = 0.0, 1e-3
     while model.ell(hi) < 1.0:
@@ -598,13 +640,22 @@ def _unstable_onset(run: March, ph: "_Phase") -> bool:
 #: Kelvin-Voigt face at 2.2e-4 and 2.2e-5 m/s run through at tolerances 1e-5 to 1e-8 (errors
 #: 5e-12 to 1.4e-7 against the reference), at 1e-9 all but one (/tmp study, 22nd session).
 _RELEASE_GROWTH = 1.1
-#: Nodes after such a release within which a turn back in time is no fold but a lost branch
-#: (handed over): with the first steps' growth 1.1 a Kelvin-Voigt face at 2.2e-5 m/s still
-#: turned back at its 10th node at tolerance 1e-9 (the first predicted step's slope 2e-3 off,
-#: the steps cut to the rounding), 2 % before the collapse the coarser marches and the
-#: reference find; a fold within the dip of the release itself is found apart
-#: (:func:`_lets_go_at_release`).
-_RELEASE_NODES = 40
+#: Within its first nodes after such a release a turn back in time after steps below this
+#: fraction of the first step is no fold but a lost branch (handed over): with the first
+#: steps' growth 1.1 a Kelvin-Voigt face at 2.2e-5 m/s still turned back at its 10th node at
+#: tolerance 1e-9 (the first predicted step's slope 2e-3 off, the steps cut to 1e-7 of the
+#: first by then, to the gap's rounding), 2 % before the collapse the coarser marches and
+#: the reference find; real folds there (fast standard linear solids and Prony series, 25-42
+#: nodes after the release) come with steps near the first (a fold within the dip of the
+#: release itself is found apart, :func:`_lets_go_at_release`).
+_RELEASE_NODES = 60
+_RELEASE_NOISE = 1e-4
+
+
+def _noise_turn(run: March, piece: int) -> bool:
+    """Whether a turn back in time is the rounding's after a face's release (see above)."""
+    return (run.released and piece == 0 and run.n - piece <= _RELEASE_NODES
+            and run.smallest < _RELEASE_NOISE * run.first_step)
 #: The zone alone released from a face at its strength limit: the decades of ``1 - b^2``
 #: sampled for the gap's dip below delta (:func:`_lets_go_at_release`), the first the
 #: largest shrinkage at which the gap must have opened for the fold to lie within the dip.
@@ -699,8 +750,13 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
     q_guess = _predict(run, piece, sigma, run.qs)
     if q_guess >= ph.q_end:
         t, sigma_end = _land_on_end(run, ph, piece, sigma)
+        if (math.isfinite(t) and ph.phase == 3 and step > _SMALLEST_STEP * run.rounding(sigma)
+                and _turns_before_the_end(run, ph, t)):
+            return q_guess, t, sigma, False, 0.5 * step, False
         if math.isfinite(t):
             return ph.q_end, t, sigma_end, True, step, True
+        if _collapsed(run, ph, piece):
+            return _collapsed(run, ph, piece)
         # (no end found from this step's prediction: the landing's secant met a NaN gap;
         # it had pushed a NaN time and reported a collapse without a time)
         if step <= _SMALLEST_STEP * run.rounding(sigma):
@@ -714,6 +770,8 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
         t, sigma = _land_on_end(run, ph, piece, sigma)
         if math.isfinite(t) and t > run.hist[0, n - 1]:
             return ph.q_end, t, sigma, True, step, True
+        if _collapsed(run, ph, piece):
+            return _collapsed(run, ph, piece)
         if step <= floor:
             run.end = "lost"
             return None
@@ -721,10 +779,34 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
     if n - piece <= DEGREE:
         growth = _RELEASE_GROWTH if run.released and piece == 0 else 2.0
         return q, t, sigma, False, growth * step, True
+    if run.released and piece == 0 and run.model.zone == 1 and ph.p(q) > 1.0:
+        # (a zone on the face larger than the face: the steps overshot the release's dip)
+        if step <= floor:
+            run.end = "lost"
+            return None
+        return q, t, sigma, False, 0.25 * step, False
     miss = _miss(run, ph, q, q_guess, t)
+    if (run.released and piece == 0 and abs(q - q_guess) > 0.5 * abs(q - run.qs[n - 1])
+            and step > floor):
+        # (the predictor missed by more than half the step's own progress: see
+        # _RELEASE_GROWTH; its nodes oscillated into a zone larger than the face)
+        return q, t, sigma, False, 0.5 * step, False
     factor = min(2.0, max(0.2, 0.8 * (run.tol / max(miss, 1e-300)) ** (1.0 / (DEGREE + 1))))
     accepted = not (miss > 3.0 * run.tol and step > floor)
     return q, t, sigma, False, max(step * factor, floor), accepted
+
+
+def _collapsed(run: March, ph: _Phase, piece: int):
+    """A zone alone within :data:`_COLLAPSED` of its collapse whose landing failed (its gap
+    nan this close: the interpolant through the last nodes dips below ``b = 0``; a lifted
+    Kelvin-Voigt face at 7.6e-2 m/s crept to ``b^2 = 1e-12 b_0^2`` and was lost): the
+    collapse at the time extrapolated from the last two nodes (an attempt's tuple), or None."""
+    n, hs, qs = run.n, run.hist[0], run.qs
+    if not (ph.phase == 3 and ph.q_end - qs[n - 1] <= _COLLAPSED and n - piece > 1
+            and qs[n - 1] > qs[n - 2]):
+        return None
+    t = hs[n - 1] + (hs[n - 1] - hs[n - 2]) / (qs[n - 1] - qs[n - 2]) * (ph.q_end - qs[n - 1])
+    return ph.q_end, t, run.sigma_of(t, ph.q_end), True, 0.0, True
 
 
 def _first_phase(run: March, r_on: float):
@@ -772,15 +854,18 @@ def march(run: March) -> None:
         if not accepted:
             continue
         p = ph.p_end if at_end else ph.p(q)
-        if (t < run.hist[0, n - 1] and retries < _FOLD_RETRIES and not at_end
+        if (t < run.hist[0, n - 1] and retries < _FOLD_RETRIES
                 and step > _SMALLEST_STEP * run.rounding(sigma)):
-            # A fold persists under smaller steps; a step that overshot the branch does not.
+            # A fold persists under smaller steps; a step that overshot the branch does not;
+            # nor does a landing on the zone's collapse that came earlier than the last node
+            # (the branch turned back in between: a standard linear solid's face at 1.2e-4
+            # m/s folded 3.4e-4 after the interpolant through such a landing, both marches
+            # of rtol 1e-4 agreeing).
             step *= 0.25
             retries += 1
             continue
         if t < run.hist[0, n - 1]:
-            first = _RELEASE_NODES if run.released and piece == 0 else DEGREE
-            if n - piece <= first or (ph.phase == 3 and crossed):
+            if n - piece <= DEGREE or _noise_turn(run, piece) or (ph.phase == 3 and crossed):
                 # Turned back within a phase's first steps (the seed scene's zone alone at
                 # tolerance 1e-7, where finer and coarser marches collapse), or after the
                 # zone alone passed the onset's bond radius (separation_kv lifted by 1.5e-6 m
@@ -808,11 +893,16 @@ def march(run: March) -> None:
             step = 100.0 * run.first_step
             crossed = True  # (once a phase: the landing's own rounding is no second crossing)
             continue
+        run.smallest = min(run.smallest, sigma - run.hist[2, n - 1])
         run.push(t, p, sigma, q)
         retries = 0
         if not at_end:
             continue
         if ph.phase == 3:
+            if _fold_before_the_end(run, piece) and retries < _FOLD_RETRIES:
+                run.n -= 1  # (the landing: the branch turns back before it; smaller steps)
+                step, retries = 0.25 * step, retries + 1
+                continue
             run.end = "collapse"
             return
         run.t_zero = t
@@ -862,6 +952,16 @@ def _fold(run: March, piece: int) -> tuple:
     return max((t_at(s), s), (ht[n - 2], hs[n - 2]))
 
 
+def _fold_before_the_end(run: March, piece: int) -> bool:
+    """Whether a march that landed on the zone's collapse (``b = 0``, its last node) came from
+    a node before a fold: the interpolant through its last nodes rises above the landing's
+    time in between (by more than a tenth of the tolerance over the phase's duration). Both
+    marches of a standard linear solid's face at rtol 1e-3 had landed so in one step from
+    ``b^2 = 0.13 R^2``, 1.8e-3 before the reference's fold, and agreed (estimate 7e-6)."""
+    t_end = run.hist[0, run.n - 1]
+    return _fold(run, piece)[0] - t_end > 1e-12 * abs(t_end)
+
+
 def _piece_of(run: March, i: int) -> tuple:
     """``(first, last)`` node of the piece holding node ``i`` (its own piece if a boundary)."""
     starts = list(run.segs[:, 0]) + [run.n]
@@ -905,31 +1005,40 @@ def _peak(run: March, which: int) -> tuple:
 
 
 def _onset_contact_peak(run: March) -> tuple:
-    """``(t, F_contact)`` of the largest contact force while the bond is pinned: at the onset,
-    but with the zone on the face the bond shrinks (``a^2 = 1 - ell^2``) and ``2 a ell`` peaks
-    at ``ell^2 = 1/2``."""
+    """``(t, F_contact)`` of the largest contact force while the bond is pinned (to the onset,
+    the face's strength limit or ``t_max``): at its end with the zone outside; on the face the
+    bond shrinks (``a^2 = 1 - ell^2``) and ``2 a ell`` peaks where ``ell^2`` first reaches 1/2
+    (``ell`` falls, if at all, from ``t = 0`` to one minimum: a lifted standard linear
+    solid's may pass 1/2 on its way down), or else at ``t = 0``."""
     model = run.model
-    t = run.t_on
-    if model.zone == 1 and model.ell(0.0) ** 2 >= 0.5:
-        t = 0.0
-    elif model.zone == 1 and model.ell(t) ** 2 > 0.5:
-        lo, hi = 0.0, t
-        for _ in range(200):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if model.ell(mid) ** 2 < 0.5 else (lo, mid)
-        t = 0.5 * (lo + hi)
+    t = min(run.t_on, model.t_strength, run.t_limit)
+    half = math.sqrt(0.5)
+    if model.zone == 1 and model.ell(0.0) >= half:
+        low = _largest(lambda s: -model.ell(s), 0.0, t) if t > 0.0 else 0.0
+        t = _first_at(model.ell, half, 0.0, low) if model.ell(low) < half else 0.0
+    elif model.zone == 1 and model.ell(t) > half:
+        t = _first_at(model.ell, half, 0.0, t)
     return t, model.forces(t, 0.0, 1)[0]
+
+
+def _first_at(f, level: float, lo: float, hi: float) -> float:
+    """Where ``f`` crosses ``level`` in ``[lo, hi]`` (one crossing; bisection)."""
+    rising = f(lo) < level
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if (f(mid) < level) == rising else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def summarise(run: March) -> dict:
     """The summary quantities of one run (SI)."""
     model, ts = run.model, run.model.time_scale
-    out = {"detached": math.isfinite(run.t_on)}
+    # the bond lets go at the onset, or where the face's strength limit comes first (the
+    # zone alone then holds the face until its rim opens, at run.t_on; or t_max comes first)
+    t = min(run.t_on, model.t_strength)
+    out = {"detached": t <= run.t_limit}
     if not out["detached"]:
         return out
-    # the bond lets go at the onset, or where the face's strength limit comes first (the
-    # zone alone then holds the face until its rim opens, at run.t_on)
-    t = min(run.t_on, model.t_strength)
     a, b = model.radii(t, 0.0, 1)
     Fc, Ft = model.forces(t, 0.0, 1)
     h_on = (model.h0 + model.v * t * ts if model.machine is None
@@ -945,8 +1054,10 @@ def summarise(run: March) -> dict:
         return out
     if run.end in ("collapse", "fold", "snap"):
         out["t_separation"] = (run.fold[0] if run.end == "fold" else run.hist[0, run.n - 1]) * ts
-    tc, Fcp = max(_onset_contact_peak(run), _peak(run, 0), key=lambda x: x[1])
-    tt, Ftp = max((t, Ft), _peak(run, 1), key=lambda x: x[1])
+    # (no nodes where t_max came before the rim of a face opened)
+    tc, Fcp = max([_onset_contact_peak(run)] + [_peak(run, 0) for _ in range(run.n > 0)],
+                  key=lambda x: x[1])
+    tt, Ftp = max([(t, Ft)] + [_peak(run, 1) for _ in range(run.n > 0)], key=lambda x: x[1])
     out.update(F_peak_total=Ftp, t_peak_total=tt * ts, F_peak_contact=Fcp,
                t_peak_contact=tc * ts)
     return out
@@ -1189,7 +1300,11 @@ _PHASE_NAMES = {2: "the bond receding", 3: "the zone alone"}
 
 def _notes(run: March, scene, estimate: float) -> list:
     notes = []
-    if run.end in ("t_max", "no_onset"):
+    if run.end == "no_onset" and run.model.t_strength <= run.t_limit:
+        notes.append(f"the face held at its strength limit from t = "
+                     f"{run.model.t_strength * run.model.time_scale:.6g} s, and its rim did not "
+                     f"open before t_max = {scene.numerics.t_max:.6g} s")
+    elif run.end in ("t_max", "no_onset"):
         what = "separation" if run.end == "t_max" else "the onset"
         notes.append(f"{what} not reached before t_max = {scene.numerics.t_max:.6g} s")
     elif run.end == "steps":
