@@ -55,10 +55,27 @@ SCENES = {
     "compliant_machine": ("compliant_machine", []),
     "compliant_machine_k10": ("compliant_machine", ["loading.machine_stiffness=10"]),
     "compliant_machine_k1": ("compliant_machine", ["loading.machine_stiffness=1"]),
+    # faces at their strength limit before the rim opens (since the twenty-second session)
+    "kv_face_gone_at_start": ("separation_kv", ["geometry.cohesive_zone=internal",
+                                                "loading.v=2e-2", "adhesion.sigma_c=1e6"]),
+    "finite_punch_face": ("finite_punch_internal", ["loading.v=2e-4", "adhesion.sigma_c=3.5e5"]),
+    "sls_face_fold": ("sls_finite_punch", ["geometry.cohesive_zone=internal", "loading.v=2.7e-4",
+                                           "adhesion.sigma_c=1.1e6"]),
+    "sls_face_released": ("sls_finite_punch", ["geometry.cohesive_zone=internal",
+                                               "loading.v=2e-2", "adhesion.sigma_c=6e5"]),
+    "prony_face": ("prony_external", ["geometry.cohesive_zone=internal", "loading.v=4e-4",
+                                      "adhesion.sigma_c=1e6"]),
 }
 OUTPUTS = {"t_detach": "t_onset", "F_total_detach": "F_onset_total",
            "t_separation": "t_separation", "F_peak_total": "F_peak_total",
            "F_peak_contact": "F_peak_contact"}
+
+
+def relative_error(value: float, ref: dict, name: str) -> float:
+    """Against the reference's value, or where that is 0 (a face bonded beyond its strength
+    at t = 0 detaches then, with no contact force) against its separation time or peak force."""
+    scale = ref[name] or ref["t_separation" if name.startswith("t_") else "F_peak_total"]
+    return abs(value - ref[name]) / abs(scale)
 
 
 def measure(name: str, rtol: float, repeat: int, method: str | None):
@@ -76,7 +93,7 @@ def measure(name: str, rtol: float, repeat: int, method: str | None):
         res = solvers.simulate(scene)
         times.append(time.perf_counter() - start)
     ref = REFERENCE[name]
-    error = max(abs(res.summary[ours] / ref[theirs] - 1.0) for ours, theirs in OUTPUTS.items())
+    error = max(relative_error(res.summary[ours], ref, theirs) for ours, theirs in OUTPUTS.items())
     return dict(solver=res.summary["solver"], first=first, median=statistics.median(times),
                 spread=(min(times), max(times)), error=error,
                 estimate=res.summary["error_estimate"], notes=res.summary["notes"])
@@ -112,7 +129,7 @@ def work_precision(repeat: int):
                 run = edge.run_near(model, tol, math.inf)
                 times.append(time.perf_counter() - start)
             summary = edge.summarise(run)
-            error = max(abs(summary[ours] / ref[theirs] - 1.0)
+            error = max(relative_error(summary[ours], ref, theirs)
                         for ours, theirs in OUTPUTS.items())
             rows.append((run.n, statistics.median(times), error))
             lines.append(f"| {name} | {run.tol:g} | {run.n} | {rows[-1][1] * 1e3:.1f} ms | "
