@@ -851,6 +851,30 @@ def _first_phase(run: March, r_on: float):
     return ph
 
 
+def _turned_back(run: March, ph: _Phase, piece: int, crossed: bool, node: tuple) -> None:
+    """A step that came back earlier than the last node (``node = (t, p, sigma, q)``, past
+    the fold retries): a fold of the branch (``run.fold``), or a lost branch."""
+    n = run.n
+    t, p, sigma, q = node
+    if (n - piece <= DEGREE or _noise_turn(run, piece)
+            or (ph.phase == 3 and crossed and ph.q_end - q > _NEAR_COLLAPSE)):
+        # Turned back within a phase's first steps (the seed scene's zone alone at
+        # tolerance 1e-7, where finer and coarser marches collapse), or after the
+        # zone alone passed the onset's bond radius (separation_kv lifted by 1.5e-6 m
+        # at 1e-2 m/s, at tolerance 1e-6 only, 1.6 % before the reference's collapse;
+        # every real fold met so far, the zone's on the face and outside, came
+        # before any such crossing of the zone alone), or within a zone alone's
+        # first steps after the face released it (_RELEASE_NODES): no fold this
+        # march can place. (Folds within _NEAR_COLLAPSE of the collapse after the
+        # crossing are real: standard linear solids and Prony series with the zone
+        # outside at 2.5e-7 .. 9e-4 m/s, within 2.3e-6 .. 1.4e-5 of the stepper.)
+        run.end = "lost"
+        return
+    run.push(t, p, sigma, q)
+    run.fold = _fold(run, piece)
+    run.end = "fold" if ph.phase == 3 else "bond_fold"
+
+
 def march(run: March) -> None:
     """The receding and zone-alone phases from the onset to separation (``run.end``)."""
     r_on = run.model.state(run.t_on, 0.0, 1)[1]
@@ -880,23 +904,7 @@ def march(run: March) -> None:
             retries += 1
             continue
         if t < run.hist[0, n - 1]:
-            if (n - piece <= DEGREE or _noise_turn(run, piece)
-                    or (ph.phase == 3 and crossed and ph.q_end - q > _NEAR_COLLAPSE)):
-                # Turned back within a phase's first steps (the seed scene's zone alone at
-                # tolerance 1e-7, where finer and coarser marches collapse), or after the
-                # zone alone passed the onset's bond radius (separation_kv lifted by 1.5e-6 m
-                # at 1e-2 m/s, at tolerance 1e-6 only, 1.6 % before the reference's collapse;
-                # every real fold met so far, the zone's on the face and outside, came
-                # before any such crossing of the zone alone), or within a zone alone's
-                # first steps after the face released it (_RELEASE_NODES): no fold this
-                # march can place. (Folds within _NEAR_COLLAPSE of the collapse after the
-                # crossing are real: standard linear solids and Prony series at 2.5e-7 ..
-                # 9e-4 m/s, the stepper's within 3e-6.)
-                run.end = "lost"
-                return
-            run.push(t, p, sigma, q)
-            run.fold = _fold(run, piece)
-            run.end = "fold" if ph.phase == 3 else "bond_fold"
+            _turned_back(run, ph, piece, crossed, (t, p, sigma, q))
             return
         if t > run.t_limit:
             run.end = "t_max"
