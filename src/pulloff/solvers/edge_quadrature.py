@@ -801,10 +801,13 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
             return None
         return q, t, sigma, False, 0.25 * step, False
     miss = _miss(run, ph, q, q_guess, t)
-    if (run.released and piece == 0 and abs(q - q_guess) > 0.5 * abs(q - run.qs[n - 1])
-            and step > floor):
+    if (run.released and piece == 0 and run.model.cr[0] > 0.0 and step > floor
+            and abs(q - q_guess) > 0.5 * abs(q - run.qs[n - 1])):
         # (the predictor missed by more than half the step's own progress: see
-        # _RELEASE_GROWTH; its nodes oscillated into a zone larger than the face)
+        # _RELEASE_GROWTH; a standard linear solid's nodes oscillated into a zone larger
+        # than the face. Not for a solid without instantaneous compliance, whose gap is
+        # a Volterra equation of the first kind: steps cut to 1e-4 creep times made a
+        # near-elastic Kelvin-Voigt face's nodes oscillate, see _FIRST_STEP_CAPPED)
         return q, t, sigma, False, 0.5 * step, False
     factor = min(2.0, max(0.2, 0.8 * (run.tol / max(miss, 1e-300)) ** (1.0 / (DEGREE + 1))))
     accepted = not (miss > 3.0 * run.tol and step > floor)
