@@ -345,6 +345,11 @@ class March:
         """The scale of ``sigma``'s rounding: its own, or the onset time's in sigma."""
         return max(abs(sigma), self.t_on / self.t_unit)
 
+    def from_release(self, piece: int) -> bool:
+        """Whether ``piece`` is a zone alone's first, released from a face at its strength
+        limit (the march's first piece then)."""
+        return self.released and piece == 0
+
     def node_ell(self, i: int) -> float:
         """The bonded load at node ``i``: the history's behind a machine spring, a rigid
         pull's at the node's time."""
@@ -566,7 +571,7 @@ def _step(run: March, ph: _Phase, sigma: float, q_guess: float, piece: int) -> t
 def _predict(run: March, piece: int, sigma: float, values: np.ndarray) -> float:
     # (a zone alone released from the face leaves its first node like e log e: that node is
     # left out once two others are there, see _RELEASE_GROWTH)
-    first = piece + 1 if run.released and piece == 0 and run.n > 2 else piece
+    first = piece + 1 if run.from_release(piece) and run.n > 2 else piece
     m = min(run.n - first, DEGREE + 1)
     return kernels.lagrange(run.hist[2], values, run.n - m, m, sigma)
 
@@ -667,7 +672,7 @@ _RELEASE_NOISE = 1e-4
 
 def _noise_turn(run: March, piece: int) -> bool:
     """Whether a turn back in time is the rounding's after a face's release (see above)."""
-    return (run.released and piece == 0 and run.n - piece <= _RELEASE_NODES
+    return (run.from_release(piece) and run.n - piece <= _RELEASE_NODES
             and run.smallest < _RELEASE_NOISE * run.first_step)
 #: The zone alone released from a face at its strength limit: the decades of ``1 - b^2``
 #: sampled for the gap's dip below delta (:func:`_lets_go_at_release`), the first the
@@ -792,16 +797,16 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
             return None
         return q, t, sigma, False, 0.25 * step, False
     if n - piece <= DEGREE:
-        growth = _RELEASE_GROWTH if run.released and piece == 0 else 2.0
+        growth = _RELEASE_GROWTH if run.from_release(piece) else 2.0
         return q, t, sigma, False, growth * step, True
-    if run.released and piece == 0 and run.model.zone == 1 and ph.p(q) > 1.0:
+    if run.from_release(piece) and run.model.zone == 1 and ph.p(q) > 1.0:
         # (a zone on the face larger than the face: the steps overshot the release's dip)
         if step <= floor:
             run.end = "lost"
             return None
         return q, t, sigma, False, 0.25 * step, False
     miss = _miss(run, ph, q, q_guess, t)
-    if (run.released and piece == 0 and run.model.cr[0] > 0.0 and step > floor
+    if (run.from_release(piece) and run.model.cr[0] > 0.0 and step > floor
             and abs(q - q_guess) > 0.5 * abs(q - run.qs[n - 1])):
         # (the predictor missed by more than half the step's own progress: see
         # _RELEASE_GROWTH; a standard linear solid's nodes oscillated into a zone larger
@@ -1086,10 +1091,12 @@ def summarise(run: March) -> dict:
         return out
     if run.end in ("collapse", "fold", "snap"):
         out["t_separation"] = (run.fold[0] if run.end == "fold" else run.hist[0, run.n - 1]) * ts
-    # (no nodes where t_max came before the rim of a face opened)
-    tc, Fcp = max([_onset_contact_peak(run)] + [_peak(run, 0) for _ in range(run.n > 0)],
-                  key=lambda x: x[1])
-    tt, Ftp = max([(t, Ft)] + [_peak(run, 1) for _ in range(run.n > 0)], key=lambda x: x[1])
+    contact, total = [_onset_contact_peak(run)], [(t, Ft)]
+    if run.n:  # (no nodes where t_max came before the rim of a face opened)
+        contact.append(_peak(run, 0))
+        total.append(_peak(run, 1))
+    tc, Fcp = max(contact, key=lambda x: x[1])
+    tt, Ftp = max(total, key=lambda x: x[1])
     out.update(F_peak_total=Ftp, t_peak_total=tt * ts, F_peak_contact=Fcp,
                t_peak_contact=tc * ts)
     return out
