@@ -777,13 +777,15 @@ def _interval_of(s, hist, n):
 
 
 @njit(cache=True)
-def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, pos, kidx):
+def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, cut, pos, kidx):
     """Panel edges in [s0, T] (sorted) and the interval of the panel each one starts; the
-    face's strength limit among them where it comes before the onset."""
+    face's strength limit among them where it comes before the onset. Only the edges from
+    ``cut`` on where ``cut > s0`` (the rest of the list is the same)."""
     c = 0
-    pos[c], kidx[c] = s0, -1 if s0 < t_on else _interval_of(s0, hist, n)
-    c += 1
-    if s0 < t_strength < min(T, t_on):
+    if cut <= s0:
+        pos[c], kidx[c] = s0, -1 if s0 < t_on else _interval_of(s0, hist, n)
+        c += 1
+    if max(s0, cut) <= t_strength < min(T, t_on) and t_strength > s0:
         pos[c], kidx[c] = t_strength, -1
         c += 1
     for i in range(2, cr.size, 2):
@@ -792,10 +794,14 @@ def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, pos, kidx):
             continue
         for j in range(DECAY_EDGES.size):
             s = T - DECAY_EDGES[j] / lam
-            if s > s0:
+            if s > s0 and s >= cut:
                 pos[c], kidx[c] = s, -1 if s < t_on else _interval_of(s, hist, n)
                 c += 1
-    for j in range(n - 1):
+    j_first = 0
+    if cut > s0:
+        while j_first < n - 1 and hist[0, j_first] < cut:
+            j_first += 1
+    for j in range(j_first, n - 1):
         if hist[0, j] >= s0 and hist[0, j + 1] > hist[0, j]:
             pos[c], kidx[c] = hist[0, j], j
             c += 1
@@ -814,16 +820,29 @@ def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, pos, kidx):
 
 
 @njit(cache=True)
+def _edges_cut(s_from, hist, n):
+    """A time from which on the panel edges are enough for :func:`_singular_points` from
+    ``s_from``: three history nodes before it (it needs the edge before the one before
+    ``s_from``), or ``-inf`` where the history has no three nodes before it."""
+    if n < 4 or not s_from > hist[0, 3]:
+        return -math.inf
+    j = _interval_of(s_from, hist, n)
+    return hist[0, j - 3] if j >= 3 else -math.inf
+
+
+@njit(cache=True)
 def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
     """The panels' edges from ``s_from`` on, sorted: ``(pos [s], interval of the panel
-    starting there (-1: before the onset), kind)``; kind 1 marks ``T`` and the times where
-    ``b_s = b_T`` (a log in the integrand), 0 those where ``a_s = b_T`` (a square root), -1 a
-    plain edge."""
+    starting there (-1: before the onset), kind, dead)``; kind 1 marks ``T`` and the times
+    where ``b_s = b_T`` (a log in the integrand), 0 those where ``a_s = b_T`` (a square root),
+    -1 a plain edge; dead 1 where the panel starting there has ``a_s > b_T`` at both its ends
+    and no crossing between, so its openings are all 0 (:func:`opening`)."""
     T = ctx[2]
     cap = 2 * n + 34 + DECAY_EDGES.size * (cr.size // 2)
     base = np.empty(cap)
     bk = np.empty(cap, dtype=np.int64)
-    m = _panel_edges(T, ctx[0], ctx[6], cr, hist, n, memory_start(T, cr), base, bk)
+    m = _panel_edges(T, ctx[0], ctx[6], cr, hist, n, memory_start(T, cr),
+                     _edges_cut(s_from, hist, n), base, bk)
     first = 0
     while first < m - 2 and base[first + 1] <= s_from:
         first += 1
@@ -834,6 +853,9 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
     pos = np.empty(2 * m + 8)
     kidx = np.empty(2 * m + 8, dtype=np.int64)
     kind = np.empty(2 * m + 8, dtype=np.int64)
+    dead = np.zeros(2 * m + 8, dtype=np.int64)
+    # (the zone alone shrunk to b_T = 0 sees its own past zone: no opening is 0 there)
+    can_die = not (ctx[5] == 0.0 and ctx[4] == 1.0)
     f_lo = np.empty(2)
     f_hi = np.empty(2)
     f_lo[0], f_lo[1] = _crossings_at_edge(base[first], bk[first], ctx, rh, hist, n, segs, deg,
@@ -843,21 +865,31 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
         lo, hi, k = base[i], base[i + 1], bk[i]
         # (the strength limit: a square root of a_s^2 = 1 - ell_s^2, on its left only)
         pos[c], kidx[c], kind[c] = lo, k, 0 if lo == ctx[6] else -1
+        start = c
         c += 1
         # (the values at hi, on this panel's interval: a join of pieces is continuous)
         f_hi[0], f_hi[1] = _crossings_at_edge(hi, k, ctx, rh, hist, n, segs, deg, w, dw)
+        lo_dead, hi_dead = can_die and f_lo[0] < 0.0, can_die and f_hi[0] < 0.0
+        root = math.nan  # (where a_s = b_T in this panel)
         for which in range(2):
             if (f_lo[which] < 0.0) != (f_hi[which] < 0.0) and f_lo[which] != 0.0 \
                     and f_hi[which] != 0.0:
                 pos[c] = _crossing_time(lo, hi, f_lo[which], f_hi[which], k, which, ctx, rh,
                                         hist, n, segs, deg, w, dw)
                 kidx[c], kind[c] = k, which
+                if which == 0:
+                    root = pos[c]
                 c += 1
             f_lo[which] = f_hi[which]
+        for j in range(start, c):
+            if root == root:
+                dead[j] = hi_dead if pos[j] >= root else lo_dead
+            else:
+                dead[j] = lo_dead and hi_dead
     pos[c], kidx[c], kind[c] = T, -2, 1
     c += 1
     order = np.argsort(pos[:c], kind="mergesort")
-    return pos[order], kidx[order], kind[order]
+    return pos[order], kidx[order], kind[order], dead[:c][order]
 
 
 @njit(cache=True)
@@ -921,7 +953,7 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
     whose stencil is final from ``states`` (:func:`_interval_from_states`)."""
     w = np.empty(deg + 1)
     dw = np.empty(deg + 1)
-    pos, kidx, kind = _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_lo)
+    pos, kidx, kind, dead = _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_lo)
     c = pos.size
     acc = 0.0
     prev_c, prev_k = -math.inf, -1
@@ -929,7 +961,7 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
         if kind[i] >= 0:
             prev_c, prev_k = pos[i], kind[i]
         lo, hi, k = max(pos[i], s_lo), min(pos[i + 1], s_hi), kidx[i]
-        if hi <= lo:
+        if hi <= lo or dead[i]:
             continue
         next_c, next_k = math.inf, -1
         for j in range(i + 1, c):
