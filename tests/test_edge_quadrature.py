@@ -154,18 +154,22 @@ def test_the_seed_scene_peaks_at_ten_times_its_onset_force(results):
 # ------------------------------------------------------------------ convergence
 @pytest.mark.parametrize("name", ["separation_kv", "sls_finite_punch"])
 def test_errors_fall_with_the_tolerance_at_high_order_in_the_nodes(name):
-    """One run at tolerances 1e-3 .. 1e-6: the error falls by 20x at least over two decades
-    of tolerance (not at every one: measured on the Kelvin-Voigt punch 1.6e-6, 6.5e-7,
-    6.4e-9, 1.7e-8, errors of either sign), and against the history's node count at a high
-    order (the predictor is of degree 5; fitted over these irregular errors, measured 6.9 on
-    the Kelvin-Voigt punch and 11.5 on the standard linear solid: asserted 4-16)."""
+    """One run at tolerances 1e-3 .. 1e-6: the larger error of the two finer runs is 10x
+    at least below the larger of the two coarser (errors of either sign, irregular from one
+    tolerance to the next: measured on the Kelvin-Voigt punch 1.6e-6, 6.5e-7, 1.2e-8,
+    1.1e-8, 136x; on the standard linear solid 1.3e-6, 7.4e-8, 4.1e-8, 9.5e-9, 31x, since
+    the square roots where the old bond radius passes the zone end take a ``u^2`` panel,
+    which made the coarse runs 10-30x more accurate: 3.7e-5 and 7.9e-7 before, when each
+    pair of tolerances two decades apart was asserted 20x apart), and falls against the
+    history's node count at a high order (the predictor is of degree 5; fitted over these
+    irregular errors, measured 7.3 and 7.6: asserted 4-16)."""
     model = edge.EdgeModel.from_scene(scene_of(name))
     rows = []
     for tol in (1e-3, 1e-4, 1e-5, 1e-6):
         run = edge.run_at(model, tol, math.inf)
         rows.append((run.n, max(errors(edge.summarise(run), name).values())))
     nodes, errs = np.array(rows).T
-    assert errs[-1] < 1e-7 and np.all(errs[2:] < errs[:2] / 20.0), rows
+    assert errs[-1] < 1e-7 and max(errs[2:]) < max(errs[:2]) / 10.0, rows
     order = -np.polyfit(np.log(nodes), np.log(errs), 1)[0]
     assert 4.0 <= order <= 16.0, (order, rows)
 

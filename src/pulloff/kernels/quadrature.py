@@ -53,6 +53,9 @@ DECAY_EDGES = np.array([1.0, 2.0, 4.0, 8.0, 13.0, 19.0, 26.0, 33.0, DECAYS])
 #: standard linear solid's error at tolerance 1e-5 grew from 4.2e-8 to 4.3e-7.
 LOG_POWER = 4
 LOG_RULE_POINTS = 12
+#: The same at a square root (where the old bond radius passes the zone end, ``a_s = b_T``):
+#: ``u^2`` makes the opening, a series in the root, smooth.
+SQRT_POWER = 2
 #: Ratio of consecutive panels graded toward ``tau = 0``.
 _GRADING = 0.25
 
@@ -741,16 +744,28 @@ def _graded_toward(lo, hi, k, c, toward_hi, m_graded, sq_end, ctx, rh, cr, hist,
 
 
 @njit(cache=True)
-def _toward_log(lo, hi, k, toward_hi, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw):
-    """[lo, hi] with a logarithmic point at its high (low) end: Gauss on the half away from
-    it, ``u^LOG_POWER`` on the half next to it (see :data:`LOG_POWER`)."""
+def _toward_point(lo, hi, k, toward_hi, power, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
+                  dw):
+    """[lo, hi] with a singular point at its high (low) end: Gauss on the half away from it,
+    ``u^power`` on the half next to it (a logarithm: :data:`LOG_POWER`; a square root: 2)."""
     mid = 0.5 * (lo + hi)
-    sub = LOG_POWER if toward_hi else -LOG_POWER
+    sub = power if toward_hi else -power
     plain = sub - sub  # (0, not a constant: see _graded_toward)
     sub_lo, sub_hi = (plain, sub) if toward_hi else (sub, plain)
     return (_history_panel(lo, mid, k, sub_lo, ctx, rh, cr, hist, n, segs, deg, gx, gw, w, dw)
             + _history_panel(mid, hi, k, sub_hi, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
                              dw))
+
+
+@njit(cache=True)
+def _substituted(kind, at_edge, points):
+    """The power of the substitution that takes a singular point of ``kind`` at a panel's
+    edge (0: none, grade toward it)."""
+    if not at_edge:
+        return 0
+    if kind == 0:
+        return SQRT_POWER
+    return LOG_POWER if kind == 1 and points >= LOG_RULE_POINTS else 0
 
 
 @njit(cache=True)
@@ -970,21 +985,25 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
                 break
         if lo == 0.0 and k < 0 and rh[0] != rh[0]:
             # behind a machine spring the lift path starts like sqrt(s) (the punch catching
-            # up with the driver, machine_lift): graded toward s = 0 with u^2 there
-            prev_c, prev_k = 0.0, 0
+            # up with the driver, machine_lift): graded toward s = 0 with u^2 there (kind 2:
+            # the path is a polynomial of high degree in sqrt(s), which one u^2 panel left
+            # 2e-9 off in the force at a stiff spring's onset)
+            prev_c, prev_k = 0.0, 2
         width = hi - lo
         need_l = (lo - prev_c) * 3.0 < width
         need_r = (next_c - hi) * 3.0 < width
         mid = 0.5 * (lo + hi) if need_l and need_r else (hi if need_l else lo)
-        if need_l and prev_k == 1 and prev_c == lo and gx.size >= LOG_RULE_POINTS:
-            acc += _toward_log(lo, mid, k, not need_l, ctx, rh, cr, hist, n, segs, deg, gx, gw,
-                               w, dw)
+        power_l = _substituted(prev_k, prev_c == lo, gx.size)
+        power_r = _substituted(next_k, next_c == hi, gx.size)
+        if need_l and power_l:
+            acc += _toward_point(lo, mid, k, not need_l, power_l, ctx, rh, cr, hist, n, segs,
+                                 deg, gx, gw, w, dw)
         elif need_l:
-            acc += _graded_toward(lo, mid, k, prev_c, not need_l, n_graded, prev_k == 0, ctx, rh,
+            acc += _graded_toward(lo, mid, k, prev_c, not need_l, n_graded, prev_k != 1, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
-        if need_r and next_k == 1 and next_c == hi and gx.size >= LOG_RULE_POINTS:
-            acc += _toward_log(mid, hi, k, need_r, ctx, rh, cr, hist, n, segs, deg, gx, gw, w,
-                               dw)
+        if need_r and power_r:
+            acc += _toward_point(mid, hi, k, need_r, power_r, ctx, rh, cr, hist, n, segs, deg,
+                                 gx, gw, w, dw)
         elif need_r:
             acc += _graded_toward(mid, hi, k, next_c, need_r, n_graded, next_k == 0, ctx, rh,
                                   cr, hist, n, segs, deg, gx, gw, w, dw)
