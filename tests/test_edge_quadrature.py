@@ -520,7 +520,7 @@ def test_far_intervals_are_integrated_as_well_as_by_the_runs_own_rule(name, tol,
         rules = args[-1]
         if rules.shape[0] > 1 and args[4] > 3 * edge.DEGREE:
             own = gap(*args[:-1], rules[-1:].copy())
-            states = np.zeros((args[-2].shape[0], 1 + 5 * 24))
+            states = np.zeros((args[-2].shape[0], 1 + 5 * 24 + 3))  # (+ the nodes')
             exact = gap(*args[:-2], states, fine)
             worst["far"] = max(worst["far"], abs(value - exact))
             worst["own"] = max(worst["own"], abs(own - exact))

@@ -387,6 +387,44 @@ def carlson_rf(x, y, z):
 
 
 @njit(cache=True)
+def carlson_rf_rd(x, y, z):
+    """``(R_F(x, y, z), R_D(x, y, z))`` from one duplication (:func:`carlson_rf` and
+    :func:`carlson_rd`, each with its own mean and series; run until both have converged)."""
+    af = (x + y + z) / 3.0
+    ad = (x + y + 3.0 * z) / 5.0
+    a0f = af
+    x0, y0 = x, y
+    qf = 3.0e3 * max(abs(af - x), abs(af - y), abs(af - z))
+    qd = 6.0e2 * max(abs(ad - x), abs(ad - y), abs(ad - z))
+    total = 0.0
+    scale = 1.0
+    while scale * qf >= abs(af) or scale * qd >= abs(ad):
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+        lam = sx * sy + sx * sz + sy * sz
+        total += scale / (sz * (z + lam))
+        scale *= 0.25
+        x, y, z = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)
+        af, ad = 0.25 * (af + lam), 0.25 * (ad + lam)
+    X = (a0f - x0) * scale / af
+    Y = (a0f - y0) * scale / af
+    Z = -(X + Y)
+    e2 = X * Y - Z * Z
+    e3 = X * Y * Z
+    rf = (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(af)
+    X = (ad - x) / ad
+    Y = (ad - y) / ad
+    Z = -(X + Y) / 3.0
+    xy, zz = X * Y, Z * Z
+    e2 = xy - 6.0 * zz
+    e3 = (3.0 * xy - 8.0 * zz) * Z
+    e4 = 3.0 * (xy - zz) * zz
+    e5 = xy * zz * Z
+    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
+    return rf, scale * series / (ad * math.sqrt(ad)) + 3.0 * total
+
+
+@njit(cache=True)
 def _zone_weight_below(p, d, A):
     return p * math.sqrt(p) * carlson_rd(A / (A + p), (p + d) / d, 1.0) / (
         3.0 * math.sqrt((A + p) * d))
@@ -404,9 +442,12 @@ def zone_weight(P, d, A):
         return P / (math.sqrt(A + P) + math.sqrt(A))
     if d > 0.0:
         return _zone_weight_below(P, d, A)
+    # the zone's weight below Q plus the zone above it, R_D and R_F of one argument triple
+    # (R_F(A e, P (A + Q), (A + Q) e) scaled by homogeneity): one duplication for both, where
+    # two took ~120 ns, most of an old element's cost in the memory
     e = -d
-    j0 = 2.0 * math.sqrt(Q) * carlson_rf(A * e, P * (A + Q), (A + Q) * e)
-    return _zone_weight_below(Q, e, A) + 0.5 * e * j0
+    rf, rd = carlson_rf_rd(A / (A + Q), (Q + e) / e, 1.0)
+    return math.sqrt(Q / ((A + Q) * e)) * (Q * rd / 3.0 + e * rf)
 
 
 @njit(cache=True)
@@ -597,6 +638,22 @@ def _node_state(j, phase, hist, rh):
 
 
 @njit(cache=True)
+def _node_rp(j, phase, hist, rh, n, states):
+    """``(r, P)`` at node ``j`` (:func:`_node_state`), kept in the last three columns of
+    ``states[j]`` (a flag, r, P) once the node is no trial (``j < n - 1``): every evaluation
+    of the memory tests the crossings at every node (the solver clears a node's entry when
+    it pushes one there)."""
+    col = states.shape[1] - 3
+    kept = j < n - 1 and j < states.shape[0]
+    if kept and states[j, col] == 1.0:
+        return states[j, col + 1], states[j, col + 2]
+    _ell, r, P = _node_state(j, phase, hist, rh)
+    if kept:
+        states[j, col], states[j, col + 1], states[j, col + 2] = 1.0, r, P
+    return r, P
+
+
+@njit(cache=True)
 def _state_sigma(x, phase, hist, i0, m, w, dw, rh):
     """(s, ds/dsigma, ell, r, P) at sigma = x (``ell`` as :func:`_node_state`'s)."""
     t, dt, p = _at_sigma(x, hist, i0, m, w, dw)
@@ -620,7 +677,7 @@ def _crossing_value(which, ell, r, P, ctx):
 
 
 @njit(cache=True)
-def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw):
+def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw, states):
     """Both crossing functions (``a_s``, then ``b_s`` against ``b_T``) at an edge s of a
     panel on interval k (-1: before the onset), from one state."""
     if k < 0:
@@ -628,9 +685,9 @@ def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw):
     else:
         i0, m, phase = _stencil(k, n, segs, deg)
         if s == hist[0, k]:
-            ell, r, P = _node_state(k, phase, hist, rh)
+            r, P = _node_rp(k, phase, hist, rh, n, states)
         elif s == hist[0, k + 1]:
-            ell, r, P = _node_state(k + 1, phase, hist, rh)
+            r, P = _node_rp(k + 1, phase, hist, rh, n, states)
         else:
             x = _sigma_of(s, k, hist, i0, m, w, dw)
             _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
@@ -792,6 +849,32 @@ def _interval_of(s, hist, n):
 
 
 @njit(cache=True)
+def _merged(pos, kidx, extras, c):
+    """``pos[:c]`` sorted (stably, as a merge sort of the whole would; and ``kidx`` with it),
+    of which ``pos[extras:c]`` (the history's nodes) are sorted already and the few before
+    them are not: those sorted by insertion, then the two merged, in O(c) where a sort of
+    all of them was most of a long history's panel edges."""
+    for i in range(1, extras):
+        p, k = pos[i], kidx[i]
+        j = i
+        while j > 0 and pos[j - 1] > p:
+            pos[j], kidx[j] = pos[j - 1], kidx[j - 1]
+            j -= 1
+        pos[j], kidx[j] = p, k
+    p2 = np.empty(c)
+    k2 = np.empty(c, dtype=np.int64)
+    a, b = 0, extras
+    for i in range(c):
+        if b >= c or (a < extras and pos[a] <= pos[b]):
+            p2[i], k2[i] = pos[a], kidx[a]
+            a += 1
+        else:
+            p2[i], k2[i] = pos[b], kidx[b]
+            b += 1
+    return p2, k2
+
+
+@njit(cache=True)
 def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, cut, pos, kidx):
     """Panel edges in [s0, T] (sorted) and the interval of the panel each one starts; the
     face's strength limit among them where it comes before the onset. Only the edges from
@@ -812,6 +895,7 @@ def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, cut, pos, kidx):
             if s > s0 and s >= cut:
                 pos[c], kidx[c] = s, -1 if s < t_on else _interval_of(s, hist, n)
                 c += 1
+    extras = c
     j_first = 0
     if cut > s0:
         while j_first < n - 1 and hist[0, j_first] < cut:
@@ -820,9 +904,7 @@ def _panel_edges(T, t_on, t_strength, cr, hist, n, s0, cut, pos, kidx):
         if hist[0, j] >= s0 and hist[0, j + 1] > hist[0, j]:
             pos[c], kidx[c] = hist[0, j], j
             c += 1
-    order = np.argsort(pos[:c], kind="mergesort")
-    p2 = pos[:c][order].copy()
-    k2 = kidx[:c][order].copy()
+    p2, k2 = _merged(pos, kidx, extras, c)
     m = 0
     for i in range(c):
         if m > 0 and p2[i] == pos[m - 1]:
@@ -846,7 +928,7 @@ def _edges_cut(s_from, hist, n):
 
 
 @njit(cache=True)
-def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
+def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from, states):
     """The panels' edges from ``s_from`` on, sorted: ``(pos [s], interval of the panel
     starting there (-1: before the onset), kind, dead)``; kind 1 marks ``T`` and the times
     where ``b_s = b_T`` (a log in the integrand), 0 those where ``a_s = b_T`` (a square root),
@@ -871,10 +953,11 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
     dead = np.zeros(2 * m + 8, dtype=np.int64)
     # (the zone alone shrunk to b_T = 0 sees its own past zone: no opening is 0 there)
     can_die = not (ctx[5] == 0.0 and ctx[4] == 1.0)
+    kept = states.shape[1] - 3  # (the nodes' (r, P): _node_rp)
     f_lo = np.empty(2)
     f_hi = np.empty(2)
     f_lo[0], f_lo[1] = _crossings_at_edge(base[first], bk[first], ctx, rh, hist, n, segs, deg,
-                                          w, dw)
+                                          w, dw, states)
     c = 0
     for i in range(first, m - 1):
         lo, hi, k = base[i], base[i + 1], bk[i]
@@ -883,7 +966,14 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
         start = c
         c += 1
         # (the values at hi, on this panel's interval: a join of pieces is continuous)
-        f_hi[0], f_hi[1] = _crossings_at_edge(hi, k, ctx, rh, hist, n, segs, deg, w, dw)
+        if 0 <= k < n - 2 and hi == hist[0, k + 1] and states[k + 1, kept] == 1.0:
+            # (a node's kept (r, P) read here: the call cost ~100 ns an edge, 80 % of these
+            # points on a long history)
+            f_hi[0] = ctx[5] + states[k + 1, kept + 1] - ctx[4]
+            f_hi[1] = f_hi[0] - states[k + 1, kept + 2]
+        else:
+            f_hi[0], f_hi[1] = _crossings_at_edge(hi, k, ctx, rh, hist, n, segs, deg, w, dw,
+                                                  states)
         lo_dead, hi_dead = can_die and f_lo[0] < 0.0, can_die and f_hi[0] < 0.0
         root = math.nan  # (where a_s = b_T in this panel)
         for which in range(2):
@@ -894,6 +984,9 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
                 kidx[c], kind[c] = k, which
                 if which == 0:
                     root = pos[c]
+                elif c - start == 2 and pos[c] < pos[c - 1]:  # (both: in order)
+                    pos[c - 1], pos[c] = pos[c], pos[c - 1]
+                    kind[c - 1], kind[c] = 1, 0
                 c += 1
             f_lo[which] = f_hi[which]
         for j in range(start, c):
@@ -903,8 +996,13 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from):
                 dead[j] = lo_dead and hi_dead
     pos[c], kidx[c], kind[c] = T, -2, 1
     c += 1
-    order = np.argsort(pos[:c], kind="mergesort")
-    return pos[order], kidx[order], kind[order], dead[:c][order]
+    # (in order as made but where a crossing's time came out past its panel's end, then
+    # sorted as before)
+    for i in range(1, c):
+        if pos[i] < pos[i - 1]:
+            order = np.argsort(pos[:c], kind="mergesort")
+            return pos[order], kidx[order], kind[order], dead[:c][order]
+    return pos[:c], kidx[:c], kind[:c], dead[:c]
 
 
 @njit(cache=True)
@@ -968,21 +1066,23 @@ def history_integral(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_lo, s_
     whose stencil is final from ``states`` (:func:`_interval_from_states`)."""
     w = np.empty(deg + 1)
     dw = np.empty(deg + 1)
-    pos, kidx, kind, dead = _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_lo)
+    pos, kidx, kind, dead = _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_lo,
+                                             states)
     c = pos.size
     acc = 0.0
     prev_c, prev_k = -math.inf, -1
+    ahead = 0  # (the first singular point after i: a scan from each i cost O(c^2))
     for i in range(c - 1):
         if kind[i] >= 0:
             prev_c, prev_k = pos[i], kind[i]
         lo, hi, k = max(pos[i], s_lo), min(pos[i + 1], s_hi), kidx[i]
         if hi <= lo or dead[i]:
             continue
-        next_c, next_k = math.inf, -1
-        for j in range(i + 1, c):
-            if kind[j] >= 0:
-                next_c, next_k = pos[j], kind[j]
-                break
+        if ahead <= i:
+            ahead = i + 1
+            while ahead < c and kind[ahead] < 0:
+                ahead += 1
+        next_c, next_k = (pos[ahead], kind[ahead]) if ahead < c else (math.inf, -1)
         if lo == 0.0 and k < 0 and rh[0] != rh[0]:
             # behind a machine spring the lift path starts like sqrt(s) (the punch catching
             # up with the driver, machine_lift): graded toward s = 0 with u^2 there (kind 2:
@@ -1039,7 +1139,8 @@ def edge_gap_split(ctx, rh, cr, hist, n, segs, deg, gx, gw, n_graded, s_split, p
     """gap(b_T)/delta; ctx = [t_on, zone, T, ell_T, r_T, P_T, t_strength] (t_strength: the
     face's strength limit, :func:`_pinned_state`; inf for none). part 0: the memory before
     s_split; 1: the rest (with the local terms); all of it: part 1 from ``-inf``. ``states``:
-    the history's intervals' Gauss states, rows of ``1 + 5 gx.size`` (:func:`history_integral`).
+    the history's intervals' Gauss states, rows of ``1 + 5 gx.size`` and the nodes' (r, P) in the
+    last three columns (:func:`history_integral`, :func:`_node_rp`).
     (One entry point: numba optimises each with its callees, so a second one for the whole
     memory cost ~1.5 s more of a first compile.)"""
     T = ctx[2]

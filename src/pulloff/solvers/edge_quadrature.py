@@ -328,8 +328,9 @@ class March:
         self.ctx[1], self.ctx[6] = self.model.zone, self.model.t_strength
         # the history's intervals' Gauss states (kernels.history_integral), grown with it
         self.rules = _rule_table(self.gx, self.gw, self.model.fastest_rate)
+        # (and the last three columns each node's (flag, r, P): kernels._node_rp)
         self.states = np.zeros((256, int(max(col + 1 + 5 * points
-                                             for points, col in self.rules[:, :2]))))
+                                             for points, col in self.rules[:, :2])) + 3))
 
     def sigma_of(self, t: float, q: float) -> float:
         """The march's parameter at time ``t`` and progress ``q``: ``t / t_onset + q``, or
@@ -424,8 +425,10 @@ class March:
         self.hist[:3, i] = t, p, sigma
         if i == 0:  # (a history begun again: see _unstable_onset)
             self.states[:, self.rules[:, 1].astype(np.int64)] = 0.0
+            self.states[:, -3] = 0.0
         elif i >= self.states.shape[0]:
             self.states = np.concatenate([self.states, np.zeros_like(self.states)])
+        self.states[i, -3] = 0.0  # (a node popped and pushed again: kernels._node_rp)
         if self.machine is not None:
             if new_piece is None:
                 self.hist[3, i], self.lifts[i] = self._lift(self.hist, i, self.segs[-1, 1])
