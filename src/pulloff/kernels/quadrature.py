@@ -538,20 +538,21 @@ def _stencil(k, n, segs, deg):
 
 
 @njit(cache=True)
-def _basis(xs, i0, m, x, w, dw):
-    """Lagrange basis at x over xs[i0:i0+m] and its derivative, into w, dw (the products of
-    ``x - x_l`` and their derivative accumulated together: no division but the m weights)."""
+def _basis(hist, row, i0, m, x, w, dw):
+    """Lagrange basis at x over hist[row, i0:i0+m] and its derivative, into w, dw (the
+    products of ``x - x_l`` and their derivative accumulated together: no division but the m
+    weights; the nodes read in place, where a row's view cost as much as the arithmetic)."""
     for j in range(m):
-        xj = xs[i0 + j]
+        xj = hist[row, i0 + j]
         val = 1.0
         der = 0.0
         den = 1.0
         for l in range(m):
             if l != j:
-                d = x - xs[i0 + l]
+                d = x - hist[row, i0 + l]
                 der = der * d + val
                 val *= d
-                den *= xj - xs[i0 + l]
+                den *= xj - hist[row, i0 + l]
         w[j] = val / den
         dw[j] = der / den
 
@@ -562,7 +563,7 @@ def _at_sigma(x, hist, i0, m, w, dw):
     (the weights sum to 1, their derivatives to 0): summed from the clock since ``t = 0``,
     ``dt/dsigma`` lost ~1e-15 of ``t`` against steps of 1e-9 on slow pulls, a relative noise
     of up to 1e-6 in the memory's integrand (found by a review)."""
-    _basis(hist[2], i0, m, x, w, dw)
+    _basis(hist, 2, i0, m, x, w, dw)
     t0 = hist[0, i0]
     t = 0.0
     dt = 0.0
@@ -1180,7 +1181,7 @@ def lift_step_weights(hist, first, i, rate, gx, gw, weights):
     for j in range(m):
         weights[j] = 0.0
     for g in range(gx.size):
-        _basis(hist[2], i0, m, lo + (hi - lo) * gx[g], basis, dbasis)
+        _basis(hist, 2, i0, m, lo + (hi - lo) * gx[g], basis, dbasis)
         lag = 0.0
         ds = 0.0
         for j in range(m):
