@@ -60,6 +60,28 @@ SQRT_POWER = 2
 _GRADING = 0.25
 
 
+@njit(cache=True, inline='always')
+def _rd_series(X, Y):
+    """R_D's seventh-order series in the duplication's last deviations (DLMF 19.36.2)."""
+    Z = -(X + Y) / 3.0
+    xy, zz = X * Y, Z * Z
+    e2 = xy - 6.0 * zz
+    e3 = (3.0 * xy - 8.0 * zz) * Z
+    e4 = 3.0 * (xy - zz) * zz
+    e5 = xy * zz * Z
+    return (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+            - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
+
+
+@njit(cache=True, inline='always')
+def _rf_series(X, Y):
+    """R_F's fifth-order series in the duplication's last deviations (DLMF 19.36.1)."""
+    Z = -(X + Y)
+    e2 = X * Y - Z * Z
+    e3 = X * Y * Z
+    return 1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0
+
+
 @njit(cache=True)
 def carlson_rd(x, y, z):
     """Carlson's ``R_D(x, y, z) = 3/2 int_0^inf dt / (sqrt((t+x)(t+y)) (t+z)^(3/2))`` for
@@ -78,16 +100,7 @@ def carlson_rd(x, y, z):
         total += scale / (sz * (z + lam))
         scale *= 0.25
         x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
-    X = (a - x) / a
-    Y = (a - y) / a
-    Z = -(X + Y) / 3.0
-    xy, zz = X * Y, Z * Z
-    e2 = xy - 6.0 * zz
-    e3 = (3.0 * xy - 8.0 * zz) * Z
-    e4 = 3.0 * (xy - zz) * zz
-    e5 = xy * zz * Z
-    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
-              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
+    series = _rd_series((a - x) / a, (a - y) / a)
     return scale * series / (a * math.sqrt(a)) + 3.0 * total
 
 
@@ -378,12 +391,7 @@ def carlson_rf(x, y, z):
         lam = sx * sy + sx * sz + sy * sz
         scale *= 0.25
         x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
-    X = (a0 - x0) * scale / a
-    Y = (a0 - y0) * scale / a
-    Z = -(X + Y)
-    e2 = X * Y - Z * Z
-    e3 = X * Y * Z
-    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
+    return _rf_series((a0 - x0) * scale / a, (a0 - y0) * scale / a) / math.sqrt(a)
 
 
 @njit(cache=True)
@@ -405,22 +413,8 @@ def carlson_rf_rd(x, y, z):
         scale *= 0.25
         x, y, z = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)
         af, ad = 0.25 * (af + lam), 0.25 * (ad + lam)
-    X = (a0f - x0) * scale / af
-    Y = (a0f - y0) * scale / af
-    Z = -(X + Y)
-    e2 = X * Y - Z * Z
-    e3 = X * Y * Z
-    rf = (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(af)
-    X = (ad - x) / ad
-    Y = (ad - y) / ad
-    Z = -(X + Y) / 3.0
-    xy, zz = X * Y, Z * Z
-    e2 = xy - 6.0 * zz
-    e3 = (3.0 * xy - 8.0 * zz) * Z
-    e4 = 3.0 * (xy - zz) * zz
-    e5 = xy * zz * Z
-    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
-              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
+    rf = _rf_series((a0f - x0) * scale / af, (a0f - y0) * scale / af) / math.sqrt(af)
+    series = _rd_series((ad - x) / ad, (ad - y) / ad)
     return rf, scale * series / (ad * math.sqrt(ad)) + 3.0 * total
 
 
