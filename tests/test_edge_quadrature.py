@@ -95,6 +95,32 @@ def test_the_zone_weight_is_its_integral(P, ratio, A):
     assert kernels.zone_weight(P, d, A) == pytest.approx(float(exact), rel=1e-13)
 
 
+@settings(max_examples=60, deadline=None)
+@given(x=st.floats(0.0, 1.0), y=st.floats(1.0, 1e12), z=st.floats(1e-3, 1e3))
+def test_one_duplication_gives_both_carlson_integrals(x, y, z):
+    """``carlson_rf_rd`` (the zone above ``Q``'s one duplication) is ``R_F`` and ``R_D`` of
+    its own calls, to rounding, where a zone's arguments fall (``x = A/(A+Q)`` may be 0)."""
+    rf, rd = kernels.carlson_rf_rd(x, y, z)
+    assert rf == pytest.approx(kernels.carlson_rf(x, y, z), rel=4e-15)
+    assert rd == pytest.approx(kernels.carlson_rd(x, y, z), rel=4e-15)
+
+
+@settings(max_examples=80, deadline=None)
+@given(extras=st.lists(st.sampled_from([0.0, 0.5, 1.0, 1.5, 2.0, 3.7]) | st.floats(0.0, 4.0),
+                       max_size=12),
+       nodes=st.lists(st.sampled_from([0.5, 1.0, 2.0]) | st.floats(0.0, 4.0), max_size=30))
+def test_the_panel_edges_merge_as_a_stable_sort_of_all_of_them(extras, nodes):
+    """``_merged`` (a few unsorted edges before the history's sorted nodes) orders them, and
+    their intervals with them, exactly as the stable sort of the whole list it replaced
+    (ties included: the panel edges then keep the largest interval of equal ones)."""
+    pos = np.array(extras + sorted(nodes), dtype=float)
+    kidx = np.arange(pos.size, dtype=np.int64)
+    order = np.argsort(pos, kind="mergesort")
+    merged, intervals = kernels._merged(pos.copy(), kidx.copy(), len(extras), pos.size)
+    assert np.array_equal(merged, pos[order])
+    assert np.array_equal(intervals, kidx[order])
+
+
 @pytest.mark.parametrize("spectrum", [Spectrum(1e6, 0.0, ((9e6, 1e-3),)),
                                       Spectrum(1e6, 0.0, ((4e6, 1e-4), (5e6, 1e-3))),
                                       Spectrum(2e5, 0.0, ((1e6, 1e-2), (1e7, 1e-5), (3e5, 1.0)))])
