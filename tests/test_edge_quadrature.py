@@ -12,6 +12,7 @@ with estimates 0.55-40x the error.
 import json
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import mpmath
 import numpy as np
@@ -499,6 +500,37 @@ def test_a_near_elastic_kelvin_voigt_face_comes_off_near_the_elastic_one(rtol):
     assert near.summary["error_estimate"] <= rtol
     assert ("lost their branch" in near.summary["notes"]) == (rtol == 1e-7), \
         near.summary["notes"]
+
+
+def test_a_looser_pair_must_agree_with_the_marches_that_ran_through(monkeypatch):
+    """Where a check at the asked tolerances loses its branch after marches that ran through
+    (here 1.00002 and 1.00001 at 8e-6 and 2e-6, rtol 1e-6), a looser pair that agrees only
+    with itself (1.000031, 1.00003025) is no answer: 3e-5 from what ran (a review's mock).
+    With nothing that ran through, the same pair is the answer, with its own estimate."""
+
+    class Run:
+        def __init__(self, tol, t, end="collapse"):
+            self.tol, self.t, self.end, self.n = tol, t, end, 1
+            self.hist = np.array([[t]])
+
+    monkeypatch.setattr(edge, "summarise", lambda run: {"t_separation": run.t})
+    looser = (Run(8e-5, 1.000031), Run(2e-5, 1.00003025))
+
+    def pair(model, rtol, tol, t_limit):
+        if round(tol / (edge._TOL_PER_RTOL * rtol)) == 10:
+            return (*looser, abs(1.000031 / 1.00003025 - 1.0), [])
+        return Run(tol, math.nan, "lost"), None, math.inf, []
+
+    monkeypatch.setattr(edge, "_checked_pair", pair)
+    model = SimpleNamespace(time_scale=1.0)
+    lost = Run(5e-7, math.nan, "lost")
+    ran = [{"t_separation": 1.00002}, {"t_separation": 1.00001}]
+    refused = edge._looser_pair(model, 1e-6, math.inf, Run(2e-6, 1.00001), lost, 2.0, ran)
+    assert refused[1] is lost and refused[2] == 2.0 and refused[3] == ()
+    coarse, fine, estimate, notes = edge._looser_pair(model, 1e-6, math.inf, lost, None,
+                                                      math.inf, [])
+    assert (coarse, fine) == looser and estimate == pytest.approx(7.5e-7, rel=1e-3)
+    assert "lost their branch" in notes[0]
 
 
 def test_a_face_behind_a_machine_spring_has_no_strength_time_to_find():

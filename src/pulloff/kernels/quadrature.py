@@ -985,7 +985,9 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from, states):
                 c += 1
             f_lo[which] = f_hi[which]
         for j in range(start, c):
-            if root == root:
+            # (a crossing time outside its panel, where t(sigma) turns near a fold: its sides
+            # are not known, so nothing there is dead; found by a review)
+            if lo <= root <= hi:
                 dead[j] = hi_dead if pos[j] >= root else lo_dead
             else:
                 dead[j] = lo_dead and hi_dead

@@ -1300,11 +1300,12 @@ class EdgeQuadratureSolver(Solver):
             from .contact import ContactSolver
             return ContactSolver().solve(scene, observers)
         with observers.progress("edge quadrature", None):
-            coarse, fine, estimate = _checked_pair(model, rtol, _TOL_PER_RTOL * rtol, t_limit)
+            coarse, fine, estimate, ran = _checked_pair(model, rtol, _TOL_PER_RTOL * rtol,
+                                                        t_limit)
             notes = ()
             if _lost(coarse, fine):
                 coarse, fine, estimate, notes = _looser_pair(model, rtol, t_limit, coarse, fine,
-                                                             estimate)
+                                                             estimate, ran)
             if fine is not None and fine.end == "steps" and fine.max_nodes < MAX_NODES:
                 return _unchecked(scene, model, coarse, fine, observers, wall)
             # Two marches that do not agree within rtol are no answer either (a zone alone
@@ -1330,18 +1331,23 @@ class EdgeQuadratureSolver(Solver):
 
 
 def _checked_pair(model: EdgeModel, rtol: float, tol: float, t_limit: float) -> tuple:
-    """``(coarse, fine, estimate)``: a march at ``tol`` and its check at a quarter of it, the
-    pair moved on by quarters while they differ by more than ``rtol`` (``fine`` None where
-    the first march hands the scene over)."""
+    """``(coarse, fine, estimate, ran)``: a march at ``tol`` and its check at a quarter of it,
+    the pair moved on by quarters while they differ by more than ``rtol`` (``fine`` None where
+    the first march hands the scene over); ``ran``: the summaries of the marches that ran
+    through."""
     coarse = run_near(model, tol, t_limit)
     if _handed_over(coarse):
-        return coarse, None, math.inf
+        return coarse, None, math.inf, []
+    ran = [summarise(coarse)]
     fine = run_near(model, coarse.tol / _CHECK, t_limit, _check_nodes(coarse))
-    estimate = _changes(summarise(coarse), summarise(fine))
+    ran.append(summarise(fine))
+    estimate = _changes(ran[-2], ran[-1])
     while estimate > rtol and fine.tol > 1e-3 * rtol and fine.end not in ("steps", "lost"):
         coarse, fine = fine, run_near(model, fine.tol / _CHECK, t_limit, _check_nodes(fine))
-        estimate = _changes(summarise(coarse), summarise(fine))
-    return coarse, fine, estimate
+        ran.append(summarise(fine))
+        estimate = _changes(ran[-2], ran[-1])
+    return coarse, fine, estimate, [s for s in ran if math.isfinite(s.get("t_separation",
+                                                                            math.nan))]
 
 
 def _lost(coarse: March, fine: March | None) -> bool:
@@ -1357,21 +1363,27 @@ _LOOSER = (10.0, 100.0)
 
 
 def _looser_pair(model: EdgeModel, rtol: float, t_limit: float, coarse: March,
-                 fine: March | None, estimate: float) -> tuple:
+                 fine: March | None, estimate: float, ran: list) -> tuple:
     """``(coarse, fine, estimate, notes)``: a pair at looser tolerances whose marches run
-    through and agree within ``rtol`` (they are then the answer, with its estimate and a
-    note), else the lost pair as it was."""
+    through and agree within ``rtol``, with each other and with every march at the asked
+    tolerances that ran through (``ran``, summaries: a looser pair that agreed only with
+    itself could be off by more than the tighter marches' differences, a review); they are
+    then the answer, with that estimate and a note. Else the lost pair as it was."""
     lost = fine if fine is not None else coarse
     for factor in _LOOSER:
-        pair = _checked_pair(model, rtol, factor * _TOL_PER_RTOL * rtol, t_limit)
-        if pair[1] is None or _handed_over(pair[1]) or pair[1].end == "steps":
+        looser, checked, agreed, _ = _checked_pair(model, rtol, factor * _TOL_PER_RTOL * rtol,
+                                                   t_limit)
+        if checked is None or _handed_over(checked) or checked.end == "steps":
             continue
-        if pair[2] <= rtol:
-            note = (f"the marches at tolerance {lost.tol:.3g} lost their branch at t = "
-                    f"{lost.hist[0, lost.n - 1] * model.time_scale:.6g} s; the values are "
-                    f"the marches at {pair[0].tol:.3g} and {pair[1].tol:.3g}, which agree "
-                    f"within rtol")
-            return (*pair, (note,))
+        answer = summarise(checked)
+        agreed = max([agreed] + [_changes(other, answer) for other in ran])
+        if agreed <= rtol:
+            where = (f" at t = {lost.hist[0, lost.n - 1] * model.time_scale:.6g} s"
+                     if lost.n else "")
+            note = (f"the marches at tolerance {lost.tol:.3g} lost their branch{where}; the "
+                    f"values are the marches at {looser.tol:.3g} and {checked.tol:.3g}, which "
+                    f"agree within rtol" + (" with those that ran through" if ran else ""))
+            return looser, checked, agreed, (note,)
     return coarse, fine, estimate, ()
 
 
