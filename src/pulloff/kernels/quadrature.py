@@ -664,7 +664,7 @@ def _state_sigma(x, phase, hist, i0, m, w, dw, rh):
 
 
 @njit(cache=True)
-def _crossing_value(which, ell, r, P, ctx):
+def _crossing_value(which, r, P, ctx):
     Q = ctx[5] + r - ctx[4]  # b_T^2 - a_s^2
     if which == 0:
         return Q
@@ -676,7 +676,7 @@ def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw, states):
     """Both crossing functions (``a_s``, then ``b_s`` against ``b_T``) at an edge s of a
     panel on interval k (-1: before the onset), from one state."""
     if k < 0:
-        ell, r, P = _pinned_state(s, rh, ctx)
+        _ell, r, P = _pinned_state(s, rh, ctx)
     else:
         i0, m, phase = _stencil(k, n, segs, deg)
         if s == hist[0, k]:
@@ -685,8 +685,8 @@ def _crossings_at_edge(s, k, ctx, rh, hist, n, segs, deg, w, dw, states):
             r, P = _node_rp(k + 1, phase, hist, rh, n, states)
         else:
             x = _sigma_of(s, k, hist, i0, m, w, dw)
-            _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
-    return _crossing_value(0, ell, r, P, ctx), _crossing_value(1, ell, r, P, ctx)
+            _t, _dt, _ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+    return _crossing_value(0, r, P, ctx), _crossing_value(1, r, P, ctx)
 
 
 @njit(cache=True)
@@ -706,11 +706,10 @@ def _crossing_time(lo, hi, flo, fhi, k, which, ctx, rh, hist, n, segs, deg, w, d
         if not lo < x < hi:
             x = 0.5 * (lo + hi)
         if k < 0:
-            ell, r, P = _pinned_state(x, rh, ctx)
-            fx = _crossing_value(which, ell, r, P, ctx)
+            _ell, r, P = _pinned_state(x, rh, ctx)
         else:
-            _t, _dt, ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
-            fx = _crossing_value(which, ell, r, P, ctx)
+            _t, _dt, _ell, r, P = _state_sigma(x, phase, hist, i0, m, w, dw, rh)
+        fx = _crossing_value(which, r, P, ctx)
         if fx == 0.0:
             break
         lo, hi, flo, fhi, side = _illinois(lo, hi, flo, fhi, x, fx, side)
@@ -964,8 +963,8 @@ def _singular_points(ctx, rh, cr, hist, n, segs, deg, w, dw, s_from, states):
         if 0 <= k < n - 2 and hi == hist[0, k + 1] and states[k + 1, kept] == 1.0:
             # (a node's kept (r, P) read here: the call cost ~100 ns an edge, 80 % of these
             # points on a long history)
-            f_hi[0] = ctx[5] + states[k + 1, kept + 1] - ctx[4]
-            f_hi[1] = f_hi[0] - states[k + 1, kept + 2]
+            r, P = states[k + 1, kept + 1], states[k + 1, kept + 2]
+            f_hi[0], f_hi[1] = _crossing_value(0, r, P, ctx), _crossing_value(1, r, P, ctx)
         else:
             f_hi[0], f_hi[1] = _crossings_at_edge(hi, k, ctx, rh, hist, n, segs, deg, w, dw,
                                                   states)

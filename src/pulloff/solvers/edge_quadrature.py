@@ -86,28 +86,6 @@ _SMALLEST_STEP = 1e-11
 #: early, with estimates 8x below that (a review).
 _LANDING_GAP = 1e-3
 _LANDING_CHECKS = 4
-
-
-def _turns_before_the_end(run: March, ph: _Phase, t_end: float) -> bool:
-    """Whether the branch between the last node and the collapse found at ``t_end`` reaches
-    a later time than that somewhere (a fold first): its time solved at fixed ``b`` where
-    ``1 - q`` is halved from the last node's, :data:`_LANDING_CHECKS` times (landings from
-    within :data:`_LANDING_GAP` are not checked)."""
-    n = run.n
-    left = ph.q_end - run.qs[n - 1]
-    if left <= _LANDING_GAP:
-        return False
-    t0 = run.hist[0, n - 1]
-    for k in range(1, _LANDING_CHECKS + 1):
-        q = ph.q_end - left * 0.5 ** k
-        t = secant(lambda s: run.gap(s, ph.p(q), ph.phase, run.sigma_of(s, q)) - 1.0, t0,
-                   1e-9 * t0, 1e-11)
-        if not math.isfinite(t):
-            return False
-        if t > t_end:
-            return True
-        t0 = t
-    return False
 #: The zone alone's ``1 - q`` (its ``b^2`` over the phase's first) within which a collapse
 #: whose landing fails is taken at the last node's time, extrapolated.
 _COLLAPSED = 1e-5
@@ -617,6 +595,28 @@ def _zone_past_bond(p: float, phase: int, ell: float, a_on2: float) -> float:
     return (1.0 - p + ell * ell if phase == 2 else p) - a_on2
 
 
+def _turns_before_the_end(run: March, ph: _Phase, t_end: float) -> bool:
+    """Whether the branch between the last node and the collapse found at ``t_end`` reaches
+    a later time than that somewhere (a fold first): its time solved at fixed ``b`` where
+    ``1 - q`` is halved from the last node's, :data:`_LANDING_CHECKS` times (landings from
+    within :data:`_LANDING_GAP` are not checked)."""
+    n = run.n
+    left = ph.q_end - run.qs[n - 1]
+    if left <= _LANDING_GAP:
+        return False
+    t0 = run.hist[0, n - 1]
+    for k in range(1, _LANDING_CHECKS + 1):
+        q = ph.q_end - left * 0.5 ** k
+        t = secant(lambda s: run.gap(s, ph.p(q), ph.phase, run.sigma_of(s, q)) - 1.0, t0,
+                   1e-9 * t0, 1e-11)
+        if not math.isfinite(t):
+            return False
+        if t > t_end:
+            return True
+        t0 = t
+    return False
+
+
 def _land_on_end(run: March, ph: _Phase, piece: int, sigma: float) -> tuple:
     """``(t, sigma)`` where the phase's measure reaches its end (``a = 0`` or ``b = 0``):
     ``t`` solved at the end's ``p``, from the predictor's ``t`` there."""
@@ -696,6 +696,8 @@ def _noise_turn(run: March, piece: int) -> bool:
     """Whether a turn back in time is the rounding's after a face's release (see above)."""
     return (run.from_release(piece) and run.n - piece <= _RELEASE_NODES
             and run.smallest < _RELEASE_NOISE * run.first_step)
+
+
 #: The zone alone released from a face at its strength limit: the decades of ``1 - b^2``
 #: sampled for the gap's dip below delta (:func:`_lets_go_at_release`), the first the
 #: largest shrinkage at which the gap must have opened for the fold to lie within the dip.
@@ -787,11 +789,12 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
     tolerance sets the next step and rejects a step that missed by more than three times."""
     n = run.n
     sigma = run.hist[2, n - 1] + step
+    floor = _SMALLEST_STEP * run.rounding(sigma)
     q_guess = _predict(run, piece, sigma, run.qs)
     if q_guess >= ph.q_end:
         t, sigma_end = _land_on_end(run, ph, piece, sigma)
-        if (math.isfinite(t) and ph.phase == 3 and step > _SMALLEST_STEP * run.rounding(sigma)
-                and _turns_before_the_end(run, ph, t)):
+        if math.isfinite(t) and ph.phase == 3 and step > floor and _turns_before_the_end(
+                run, ph, t):
             return q_guess, t, sigma, False, 0.5 * step, False
         if math.isfinite(t):
             return ph.q_end, t, sigma_end, True, step, True
@@ -800,12 +803,8 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
             return collapsed
         # (no end found from this step's prediction: the landing's secant met a NaN gap;
         # it had pushed a NaN time and reported a collapse without a time)
-        if step <= _SMALLEST_STEP * run.rounding(sigma):
-            run.end = "lost"
-            return None
-        return q_guess, t, sigma, False, 0.25 * step, False
+        return _shorter(run, step, floor)
     q, t = _step(run, ph, sigma, q_guess, piece)
-    floor = _SMALLEST_STEP * run.rounding(sigma)
     if not (math.isfinite(t) and math.isfinite(q) and q <= ph.q_end):
         # the secants went past a = 0 (or b = 0): land there, or take a shorter step
         t, sigma = _land_on_end(run, ph, piece, sigma)
@@ -814,19 +813,13 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
         collapsed = _collapsed(run, ph, piece, step)
         if collapsed:
             return collapsed
-        if step <= floor:
-            run.end = "lost"
-            return None
-        return q, t, sigma, False, 0.25 * step, False
+        return _shorter(run, step, floor)
     if n - piece <= DEGREE:
         growth = _RELEASE_GROWTH if run.from_release(piece) else 2.0
         return q, t, sigma, False, growth * step, True
     if run.from_release(piece) and run.model.zone == 1 and ph.p(q) > 1.0:
         # (a zone on the face larger than the face: the steps overshot the release's dip)
-        if step <= floor:
-            run.end = "lost"
-            return None
-        return q, t, sigma, False, 0.25 * step, False
+        return _shorter(run, step, floor)
     miss = _miss(run, ph, q, q_guess, t)
     if (run.from_release(piece) and run.model.cr[0] > 0.0 and step > floor
             and abs(q - q_guess) > 0.5 * abs(q - run.qs[n - 1])):
@@ -839,6 +832,15 @@ def _advance(run: March, ph: _Phase, piece: int, step: float):
     factor = min(2.0, max(0.2, 0.8 * (run.tol / max(miss, 1e-300)) ** (1.0 / (DEGREE + 1))))
     accepted = not (miss > 3.0 * run.tol and step > floor)
     return q, t, sigma, False, max(step * factor, floor), accepted
+
+
+def _shorter(run: March, step: float, floor: float):
+    """A rejected try that asks for a quarter of the step, or None (``run.end = "lost"``)
+    where the step is at its floor already."""
+    if step <= floor:
+        run.end = "lost"
+        return None
+    return math.nan, math.nan, math.nan, False, 0.25 * step, False
 
 
 def _collapsed(run: March, ph: _Phase, piece: int, step: float):
