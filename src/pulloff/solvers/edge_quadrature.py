@@ -34,6 +34,7 @@ elements adaptively.
 from __future__ import annotations
 
 import math
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -107,6 +108,20 @@ _FOLD_RETRIES = 6
 #: the Prony pull 3x less accurate, 100 runs through everywhere within the reference's
 #: values.
 _CREEP_TIMES = 100.0
+#: The phases whose first piece, from an onset reached from below, is predicted in
+#: ``sqrt(sigma - sigma0)`` from its first node (:func:`_predict`). The bond receding from
+#: the onset leaves it like ``c1 s + c2 s^(3/2) + ...`` in ``s = sigma - sigma0`` (the
+#: openings of the elements it releases grow like square roots): a predictor in ``s`` missed
+#: by 10-200 times more at the same nodes and held the steps to growths of ~1.1-1.3 for ~25
+#: steps after the onset (separation_kv at tolerance 2e-6: 69 nodes in that piece, 55
+#: graded). Not graded: the zone alone (3; no faster, and 10x less accurate on separation_kv
+#: at rtol 1e-4), a bond lifted past its onset at ``t = 0`` that recedes smoothly from its
+#: jump (a degree-5 predictor in ``sqrt`` holds a smooth branch to ``s^(5/2)`` only; those
+#: marches folded at negative times), pieces after a landing. The history's interpolants
+#: stay in ``sigma``: in ``sqrt(s)`` they turned a square root of the openings (where the
+#: zone end passes the onset's bond radius, which ``a_s`` leaves like ``1 - c s``) into one
+#: of ``w^2 - w*^2``, which the ``u^2`` panels do not integrate (noisy gaps, a lost landing).
+_GRADED = (2,)
 #: The smallest rtol: below it a run takes seconds to minutes.
 RTOL_FLOOR = 1e-9
 #: The outputs whose change between the two runs is the estimate.
@@ -284,6 +299,7 @@ class March:
     refusal: list = field(default_factory=list)  # the stepper's lines, where it refuses
     released: bool = False  # the zone alone from a face at its strength limit: its first piece
     smallest: float = math.inf  # the smallest step taken (in sigma)
+    graded_from: float = math.nan  # the sigma of a graded piece's first node (_GRADED)
     max_nodes: int = MAX_NODES
     end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
@@ -392,14 +408,16 @@ class March:
             split, part = -math.inf, 1
         return kernels.edge_gap_split(*args, split, part, self.states, self.rules) + alone
 
-    def push(self, t, p, sigma, q, new_piece=None):
+    def push(self, t, p, sigma, q, new_piece=None, graded=False):
         """A node; behind a machine spring with its bonded load and lift (a piece's first
-        node: the one before it at the same time, or the path's before the onset)."""
+        node: the one before it at the same time, or the path's before the onset; ``graded``:
+        the piece is predicted in ``sqrt(sigma - sigma0)`` from it, see :data:`_GRADED`)."""
         i = self.n
         if i >= self.max_nodes:
             raise _Steps()
         if new_piece is not None:
             self.segs = np.vstack([self.segs, [[i, new_piece]]]).astype(np.int64)
+            self.graded_from = sigma if graded else math.nan
         self.hist[:3, i] = t, p, sigma
         if i == 0:  # (a history begun again: see _unstable_onset)
             self.states[:, self.rules[:, 1].astype(np.int64)] = 0.0
@@ -451,8 +469,10 @@ def secant(f, x0: float, h: float, xtol: float = 1e-14, patience: int = 0) -> fl
     return x1
 
 
-def illinois(f, lo: float, hi: float, f_lo: float, f_hi: float, xtol: float) -> float:
-    """The root of ``f`` in ``[lo, hi]`` (``f_lo``, ``f_hi`` of opposite signs)."""
+def illinois(f, lo: float, hi: float, f_lo: float, f_hi: float, xtol: float,
+             ftol: float = 0.0) -> float:
+    """The root of ``f`` in ``[lo, hi]`` (``f_lo``, ``f_hi`` of opposite signs): to ``xtol``,
+    or where ``|f| <= ftol`` (its rounding)."""
     side, x = 0, hi
     for _ in range(100):
         if hi - lo <= xtol:
@@ -461,7 +481,7 @@ def illinois(f, lo: float, hi: float, f_lo: float, f_hi: float, xtol: float) -> 
         if not lo < x < hi:
             x = 0.5 * (lo + hi)
         fx = f(x)
-        if fx == 0.0:
+        if abs(fx) <= ftol:
             return x
         if (fx < 0.0) == (f_lo < 0.0):
             lo, f_lo = x, fx
@@ -543,12 +563,16 @@ def _step(run: March, ph: _Phase, sigma: float, q_guess: float, piece: int) -> t
     def t_of(q):
         return run.t_of(sigma, q)
 
+    def whole(q0):
+        q = secant(lambda q: run.gap(t_of(q), ph.p(q), ph.phase, sigma) - 1.0, q0,
+                   1e-7 * max(abs(q0), 1e-3), xtol, patience=_PATIENCE)
+        return q, t_of(q)
+
     xtol = _STEP_XTOL * run.tol
     if run.n - piece <= DEGREE + 3:
-        q = secant(lambda q: run.gap(t_of(q), ph.p(q), ph.phase, sigma) - 1.0, q_guess,
-                   1e-7 * max(abs(q_guess), 1e-3), xtol, patience=_PATIENCE)
-        return q, t_of(q)
+        return whole(q_guess)
     split = run.hist[0, run.n - 2 - DEGREE]
+    predicted = q_guess
     for _ in range(4):
         h = 1e-6 * max(abs(q_guess), 1e-2)
         old = run.gap(t_of(q_guess), ph.p(q_guess), ph.phase, sigma, 0, split)
@@ -563,9 +587,11 @@ def _step(run: March, ph: _Phase, sigma: float, q_guess: float, piece: int) -> t
                    patience=_PATIENCE)
         # the linearisation's error, ~ (q - q_guess)^2, far below the step's tolerance
         if (q - q_guess) ** 2 <= 1e-3 * run.tol * max(abs(q), 1e-2):
-            break
+            return q, t_of(q)
         q_guess = q
-    return q, t_of(q)
+    # (the old memory was not linear over the step after four tries: a kink of the openings
+    # in it; the root had been taken from the last linearisation as it was)
+    return whole(predicted)
 
 
 def _predict(run: March, piece: int, sigma: float, values: np.ndarray) -> float:
@@ -573,6 +599,9 @@ def _predict(run: March, piece: int, sigma: float, values: np.ndarray) -> float:
     # left out once two others are there, see _RELEASE_GROWTH)
     first = piece + 1 if run.from_release(piece) and run.n > 2 else piece
     m = min(run.n - first, DEGREE + 1)
+    if run.graded_from == run.graded_from:
+        return kernels.lagrange_graded(run.hist[2], values, run.n - m, m, sigma,
+                                       run.graded_from)
     return kernels.lagrange(run.hist[2], values, run.n - m, m, sigma)
 
 
@@ -649,8 +678,10 @@ def _land_on_kink(run: March, ph: _Phase, piece: int, sigma: float, before: floa
         p = ph.p(q)
         return _zone_past_bond(p, ph.phase, run.ell_at(t, p, s, ph.phase), a_on2)
 
+    # (to the residual's rounding: its last bits had taken ~20 more steps on separation_kv
+    # at tolerance 8e-6, the Illinois rule halving one side's value each time)
     s = illinois(residual, run.hist[2, run.n - 1], sigma, before, after,
-                 1e-15 * run.rounding(sigma))
+                 1e-15 * run.rounding(sigma), 4.0 * sys.float_info.epsilon * max(a_on2, 1.0))
     q, t = found[s] if s in found else _step(run, ph, s, _predict(run, piece, s, run.qs),
                                              piece)
     return q, t, s
@@ -866,7 +897,8 @@ def _first_phase(run: March, r_on: float):
         ph = _Phase(3, 1.0, 0.0)
     else:
         ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
-    if run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12:
+    jumped = run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12
+    if jumped:
         jump = _jump_at_zero(run, r_on)
         if jump is None:
             run.end = "unstable_onset"
@@ -879,7 +911,8 @@ def _first_phase(run: March, r_on: float):
     if ph.phase == 3 and math.isnan(run.t_zero):
         run.t_zero = min(run.t_on, run.model.t_strength)
     run.released = ph.phase == 3 and r_on >= 1.0
-    run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase)
+    run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase,
+             graded=ph.phase in _GRADED and not jumped)
     return ph
 
 
