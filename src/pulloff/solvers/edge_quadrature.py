@@ -559,7 +559,8 @@ def _step(run: March, ph: _Phase, sigma: float, q_guess: float, piece: int) -> t
     """``(q, t)`` on the branch at ``sigma`` (``t = March.t_of(sigma, q)``). The memory older than
     the last ``DEGREE + 2`` nodes is linear in ``q`` over a step (two evaluations, again at
     the root while it moved by more than the linearisation allows), only the rest is
-    evaluated at every secant."""
+    evaluated at every secant; where four linearisations do not settle, the whole gap is
+    solved from the predictor."""
     def t_of(q):
         return run.t_of(sigma, q)
 
