@@ -462,16 +462,12 @@ def test_a_fold_near_the_collapse_after_the_bond_radius_is_a_fold():
     alone passes the onset's bond radius, then turns back at b^2 ~ 1e-2 b_0^2. Such turns
     were all taken for lost branches (one mid-phase turn was false: see above) and the scene
     went to the stepper (0.4 s; 0.1228080755 s, its estimate 5.5e-6): within 5 % of the
-    collapse they are folds, the stepper's value within rtol here (measured: 3.7e-5 at rtol
-    1e-4, whose estimate is 2.1e-5, and 2.4e-6 at rtol 1e-6; the march at 2e-4 lands on the
-    fold 1.6e-6 from the stepper's value before the twenty-fourth session's predictor, 3.7e-5
-    after: the fold's nodes differ)."""
-    for rtol in (1e-4, 1e-6):
-        res = solvers.simulate(scene_of("sls_finite_punch", "geometry.cohesive_zone=external",
-                                        "loading.v=1.073e-4", "adhesion.sigma_c=1.943e6",
-                                        f"numerics.rtol={rtol}"))
-        assert res.summary["solver"] == "edge_quadrature"
-        assert res.t_separation == pytest.approx(0.12280807545821468, rel=max(rtol, 5.5e-6))
+    collapse they are folds, the stepper's value within 2.7e-6 here."""
+    res = solvers.simulate(scene_of("sls_finite_punch", "geometry.cohesive_zone=external",
+                                    "loading.v=1.073e-4", "adhesion.sigma_c=1.943e6",
+                                    "numerics.rtol=1e-4"))
+    assert res.summary["solver"] == "edge_quadrature"
+    assert res.t_separation == pytest.approx(0.12280807545821468, rel=1e-5)
 
 
 def test_a_landing_on_another_branch_past_a_fold_is_refused():
@@ -695,48 +691,10 @@ def test_the_gap_is_smooth_in_a_steps_unknown_on_a_slow_pull(monkeypatch):
     assert deviations[0] <= 3e-12
 
 
-@given(st.lists(st.floats(-1.0, 1.0), min_size=6, max_size=6),
-       st.floats(1e-7, 1e-2), st.floats(1.5, 2.5))
-@settings(max_examples=40, deadline=None)
-def test_the_graded_predictor_is_exact_on_half_integer_powers(c, first, growth):
-    """A branch leaving its piece's start like ``sum c_k s^(k/2)`` (``k = 1..6``, no constant
-    term past the start's value) is a polynomial of degree 6 in ``sqrt(s)``: the graded
-    predictor through 7 nodes (the start and six steps growing geometrically, as a march's
-    first steps do) extrapolates it to rounding, where the one in ``s`` misses by ~1e-3 of its
-    size on ``s^(3/2)`` alone."""
-    x0 = 3.0
-    s = first * growth ** np.arange(7.0) - first
-    xs = x0 + np.concatenate((s, [s[-1] * growth]))
-    def branch(x):
-        u = math.sqrt(x - x0)
-        return 0.7 + sum(ck * u ** (k + 1) for k, ck in enumerate(c))
-    ys = np.array([branch(x) for x in xs])
-    scale = 1.0 + sum(abs(ck) for ck in c)
-    ahead = kernels.lagrange_graded(xs, ys, 0, 7, xs[-1], x0)
-    assert abs(ahead - ys[-1]) <= 1e-10 * scale
-    ys_half = np.array([(x - x0) ** 1.5 for x in xs])
-    plain = kernels.lagrange(xs, ys_half, 1, 6, xs[-1])
-    assert abs(plain - ys_half[-1]) > 1e-4 * ys_half[-1]
-
-
-def test_the_receding_bond_is_predicted_in_the_square_root_of_its_parameter():
-    """The bond receding from the onset moves like ``c1 s + c2 s^(3/2)`` in its parameter: a
-    march at tolerance 2e-6 on separation_kv takes 55 nodes to ``a = 0`` with the graded
-    predictor, 70 with one in ``s`` (twenty-fourth session), and the separation it finds is
-    3.6e-8 from the reference's (4.1e-8 before; the march's tolerance is 2e-6)."""
-    model = edge.EdgeModel.from_scene(scene_of("separation_kv"))
-    run = edge.run_at(model, 2e-6, math.inf)
-    assert run.end == "collapse"
-    receding = run.segs[1, 0] - run.segs[0, 0]
-    assert receding <= 60
-    ref = REFERENCE["separation_kv"]["t_separation"]
-    assert edge.summarise(run)["t_separation"] == pytest.approx(ref, rel=1e-7)
-
-
 def test_illinois_stops_at_the_residuals_rounding():
     """With ``ftol`` the Illinois rule stops at the first point whose residual is within it
     (a landing on the kink took ~20 more steps for the last bits of a residual of size 1);
-    without, it runs to ``xtol`` (here from both ends of a bracket of a line)."""
+    without, it runs to ``xtol``."""
     calls = []
 
     def f(x):
@@ -745,7 +703,6 @@ def test_illinois_stops_at_the_residuals_rounding():
 
     loose = edge.illinois(f, 0.0, 1.0, f(0.0), f(1.0), 1e-15, 1e-6)
     assert abs(f(loose)) <= 1e-6 and len(calls) <= 5
-    calls.clear()
     tight = edge.illinois(f, 0.0, 1.0, f(0.0), f(1.0), 1e-15)
     assert tight == pytest.approx(0.3, abs=1e-15)
 

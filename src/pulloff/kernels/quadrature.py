@@ -489,25 +489,6 @@ def lagrange(xs, ys, i0, n, x):
 
 
 @njit(cache=True)
-def lagrange_graded(xs, ys, i0, n, x, x0):
-    """:func:`lagrange` in ``sqrt(x - x0)`` (``x0 <= xs``): exact on ``c1 (x - x0) + c2 (x -
-    x0)^(3/2) + ...`` to degree ``n - 1`` in ``sqrt``."""
-    tot = 0.0
-    u = math.sqrt(max(x - x0, 0.0))
-    for j in range(i0, i0 + n):
-        num = 1.0
-        den = 1.0
-        uj = math.sqrt(max(xs[j] - x0, 0.0))
-        for m in range(i0, i0 + n):
-            if m != j:
-                um = math.sqrt(max(xs[m] - x0, 0.0))
-                num *= u - um
-                den *= uj - um
-        tot += ys[j] * num / den
-    return tot
-
-
-@njit(cache=True)
 def opening(ell_s, r_s, P_s, ell_T, r_T, P_T):
     """int_0^{b_T} g(x, s) / sqrt(b_T^2 - x^2) dx with g = ell_s - sqrt(b_s^2 - x^2)_+ on
     x > a_s (0 inside): the opening's load against a bonded element."""

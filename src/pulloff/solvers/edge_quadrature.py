@@ -108,20 +108,6 @@ _FOLD_RETRIES = 6
 #: the Prony pull 3x less accurate, 100 runs through everywhere within the reference's
 #: values.
 _CREEP_TIMES = 100.0
-#: The phases whose first piece, from an onset reached from below, is predicted in
-#: ``sqrt(sigma - sigma0)`` from its first node (:func:`_predict`). The bond receding from
-#: the onset leaves it like ``c1 s + c2 s^(3/2) + ...`` in ``s = sigma - sigma0`` (the
-#: openings of the elements it releases grow like square roots): a predictor in ``s`` missed
-#: by 10-200 times more at the same nodes and held the steps to growths of ~1.1-1.3 for ~25
-#: steps after the onset (separation_kv at tolerance 2e-6: 69 nodes in that piece, 55
-#: graded). Not graded: the zone alone (3; no faster, and 10x less accurate on separation_kv
-#: at rtol 1e-4), a bond lifted past its onset at ``t = 0`` that recedes smoothly from its
-#: jump (a degree-5 predictor in ``sqrt`` holds a smooth branch to ``s^(5/2)`` only; those
-#: marches folded at negative times), pieces after a landing. The history's interpolants
-#: stay in ``sigma``: in ``sqrt(s)`` they turned a square root of the openings (where the
-#: zone end passes the onset's bond radius, which ``a_s`` leaves like ``1 - c s``) into one
-#: of ``w^2 - w*^2``, which the ``u^2`` panels do not integrate (noisy gaps, a lost landing).
-_GRADED = (2,)
 #: The smallest rtol: below it a run takes seconds to minutes.
 RTOL_FLOOR = 1e-9
 #: The outputs whose change between the two runs is the estimate.
@@ -299,7 +285,6 @@ class March:
     refusal: list = field(default_factory=list)  # the stepper's lines, where it refuses
     released: bool = False  # the zone alone from a face at its strength limit: its first piece
     smallest: float = math.inf  # the smallest step taken (in sigma)
-    graded_from: float = math.nan  # the sigma of a graded piece's first node (_GRADED)
     max_nodes: int = MAX_NODES
     end: str = ""  # collapse | fold | snap | unstable_onset | t_max | no_onset | steps
     fold: tuple = ()  # (t, sigma) of a fold
@@ -408,16 +393,14 @@ class March:
             split, part = -math.inf, 1
         return kernels.edge_gap_split(*args, split, part, self.states, self.rules) + alone
 
-    def push(self, t, p, sigma, q, new_piece=None, graded=False):
+    def push(self, t, p, sigma, q, new_piece=None):
         """A node; behind a machine spring with its bonded load and lift (a piece's first
-        node: the one before it at the same time, or the path's before the onset; ``graded``:
-        the piece is predicted in ``sqrt(sigma - sigma0)`` from it, see :data:`_GRADED`)."""
+        node: the one before it at the same time, or the path's before the onset)."""
         i = self.n
         if i >= self.max_nodes:
             raise _Steps()
         if new_piece is not None:
             self.segs = np.vstack([self.segs, [[i, new_piece]]]).astype(np.int64)
-            self.graded_from = sigma if graded else math.nan
         self.hist[:3, i] = t, p, sigma
         if i == 0:  # (a history begun again: see _unstable_onset)
             self.states[:, self.rules[:, 1].astype(np.int64)] = 0.0
@@ -600,9 +583,6 @@ def _predict(run: March, piece: int, sigma: float, values: np.ndarray) -> float:
     # left out once two others are there, see _RELEASE_GROWTH)
     first = piece + 1 if run.from_release(piece) and run.n > 2 else piece
     m = min(run.n - first, DEGREE + 1)
-    if run.graded_from == run.graded_from:
-        return kernels.lagrange_graded(run.hist[2], values, run.n - m, m, sigma,
-                                       run.graded_from)
     return kernels.lagrange(run.hist[2], values, run.n - m, m, sigma)
 
 
@@ -898,8 +878,7 @@ def _first_phase(run: March, r_on: float):
         ph = _Phase(3, 1.0, 0.0)
     else:
         ph = _Phase(2, r_on, max(ell_on ** 2, 1e-300))
-    jumped = run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12
-    if jumped:
+    if run.t_on == 0.0 and run.machine is None and run.onset_gap(0.0) > 1.0 + 1e-12:
         jump = _jump_at_zero(run, r_on)
         if jump is None:
             run.end = "unstable_onset"
@@ -912,8 +891,7 @@ def _first_phase(run: March, r_on: float):
     if ph.phase == 3 and math.isnan(run.t_zero):
         run.t_zero = min(run.t_on, run.model.t_strength)
     run.released = ph.phase == 3 and r_on >= 1.0
-    run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase,
-             graded=ph.phase in _GRADED and not jumped)
+    run.push(run.t_on, ph.p0, run.sigma_of(run.t_on, 0.0), 0.0, new_piece=ph.phase)
     return ph
 
 
