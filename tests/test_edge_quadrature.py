@@ -724,3 +724,19 @@ def test_a_step_whose_old_memory_is_not_linear_solves_the_whole_gap():
     q, t = edge._step(run, SimpleNamespace(p=lambda q: q, phase=2), 1.0, 0.4499, 0)
     assert abs(gap(t, q, 2, 1.0) - 1.0) <= 1e-12 and q == pytest.approx(0.45 + 0.9998e-4,
                                                                        rel=1e-6)
+
+
+def test_a_step_onto_the_collapse_across_the_kink_lands_on_the_kink_first():
+    """A Kelvin-Voigt pull lifted by 1.36e-7 m and pulled at 9.2e-2 m/s: its zone alone
+    passes the onset's bond radius (a kink of the openings) within the last steps before
+    the collapse. Coarse marches stepped from before the kink straight onto the collapse
+    and agreed with each other 2.9e-4 from the independent reference (rtol 1e-4, estimate
+    3.2e-5; found by a review); now such a step is shortened until the kink is landed on:
+    1.2e-5 off, estimate 1.4e-5. The reference (``references.edge`` at N = 32 and 64, 3.4e-8
+    apart, 845 s) puts the separation at 1.73437488813e-4 s."""
+    res = solvers.simulate(scene_of("separation_kv", "geometry.cohesive_zone=external",
+                                    "loading.v=0.0923663", "adhesion.sigma_c=877224",
+                                    "loading.h0=1.35815e-07", "numerics.rtol=1e-4"))
+    assert res.summary["solver"] == "edge_quadrature"
+    error = abs(res.t_separation / 1.73437488813e-4 - 1.0)
+    assert error <= 1e-4 and res.summary["error_estimate"] >= 0.1 * error
