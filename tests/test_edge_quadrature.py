@@ -502,6 +502,29 @@ def test_a_near_elastic_kelvin_voigt_face_comes_off_near_the_elastic_one(rtol):
         near.summary["notes"]
 
 
+def test_the_contact_stepper_refuses_a_near_elastic_face_and_the_floor_ends_with_a_note():
+    """A Kelvin-Voigt face whose creep time is below ``contact.NEAR_ELASTIC_FACE`` of
+    ``delta / v``: the contact stepper's zone alone jumped out right after the release (eta =
+    0.1: 1.2e-4 early at rtol 1e-6, estimate 3e-8), so it refuses it with one line; eta = 1
+    it takes. At the edge quadrature's rtol floor the eta = 1e-3 face, whose marches lose
+    their branch, had gone to the stepper and not finished in 10 minutes (its releases of
+    2e7 elements a trial, since capped): it now ends at once with no separation time and
+    says why."""
+    from pulloff.solvers.contact import ContactSolver
+
+    with pytest.raises(SceneError, match=r"material\.eta = 0\.1: a Kelvin-Voigt face whose "
+                       r"creep time eta / G is 6\.7e-06"):
+        solvers.check(scene_of("finite_punch_face", "material.eta=0.1",
+                               "numerics.method=stepper"))
+    assert not ContactSolver().unsupported(scene_of("finite_punch_face", "material.eta=1",
+                                                    "numerics.method=stepper"))
+    floor = solvers.simulate(scene_of("finite_punch_face", "material.eta=1e-3",
+                                      "numerics.rtol=1e-9"))
+    assert floor.summary["solver"] == "edge_quadrature" and math.isnan(floor.t_separation)
+    assert "the contact stepper does not take the scene: material.eta = 1e-3" in \
+        floor.summary["notes"]
+
+
 def test_a_looser_pair_must_agree_with_the_marches_that_ran_through(monkeypatch):
     """Where a check at the asked tolerances loses its branch after marches that ran through
     (here 1.00002 and 1.00001 at 8e-6 and 2e-6, rtol 1e-6), a looser pair that agrees only

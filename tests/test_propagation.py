@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from pulloff.io.scene_file import override
+from pulloff.kernels import contact as K
 from pulloff import solvers
 from pulloff.model import analytic
 from pulloff.solvers import (contact, contact_fold, contact_replay, contact_setup,
@@ -168,6 +169,27 @@ def test_fast_pull_comes_apart_by_collapse_at_every_level():
         errors.append(level.summary["t_separation"] / reference - 1.0)
     assert errors[0] < errors[1] < 0.0, errors  # early at both, the finer less so
     assert abs(errors[1]) < 5e-6 and abs(errors[0]) > 4.0 * abs(errors[1]), errors
+
+
+def test_a_receding_edge_releases_at_most_its_cap_in_one_step():
+    """Released elements are spaced at the zone's width when the step starts: on a face whose
+    rim has just opened (a zone 6e-8 of the radius wide) a trial receding to 0.79 R asked for
+    5.6e7 of them (17 s a trial on a near-elastic Kelvin-Voigt face, minutes a run). The
+    count stops at ``MOST_RELEASED`` zone spacings' worth (``Stepper.most_released``)."""
+    spacing = 6e-8 / 16.0
+    edges = np.array([1.0 - 6e-8, 1.0, 1.0 - 6e-8, 1.0, 1.0, spacing, 0.0])
+    counts = []
+    for most in (1448.0, math.inf):
+        edges[-1] = most
+        sc = np.zeros(K.S_N)
+        sc[K.S_LIVE_END] = math.inf
+        K.trial_ranges(0.79, 1.0, np.array([0.5, 1.0]), 2, edges, np.zeros(3),
+                       np.empty((3, 3)), sc)
+        counts.append(sc[K.S_K_ALPHA])
+    assert counts == [1448.0, math.ceil((1.0 - 6e-8 - 0.79) / spacing)]
+    stepper = Stepper(contact_setup.setup(load_scene(CONFIGS / "finite_punch_internal.yaml")),
+                      16, 1.0)
+    assert stepper.most_released == contact_stepper.MOST_RELEASED * stepper.per_release
 
 
 def test_finite_punch_force_never_exceeds_the_strength_limit():
@@ -793,7 +815,6 @@ def test_a_replay_started_where_the_memory_has_decayed_is_the_whole_replay():
     their slowest mode has decayed 37 e-folds (a standard linear solid pulled at 1e-7 m/s,
     to its onset: the arm forgets in a fraction of the pull). The modes are those of a replay
     from t = 0 to rounding (measured: identical), and most rows are skipped."""
-    from pulloff.kernels import contact as K
 
     scene = load_scene(CONFIGS / "sls_finite_punch.yaml",
                        overrides=["model.until=detach", "loading.v=1e-7"])

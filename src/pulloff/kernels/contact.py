@@ -972,7 +972,7 @@ def _memory_integral(xi, status, D, tj, n_all, kappa_arms, tau_arms, t, alpha, i
 #: Entries of ``edges`` in :func:`trial_ranges`: the edges now and one step earlier (nan
 #: after an event), the earlier step's length in this one's (nan: none) and the released
 #: elements' spacing.
-E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING = range(6)
+E_ALPHA, E_BETA, E_ALPHA_PREV, E_BETA_PREV, E_R, E_SPACING, E_MOST_RELEASED = range(7)
 _TINY = 1e-13
 
 
@@ -992,8 +992,9 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     """What a trial step with edges ``alpha``, ``beta`` advances: its paths into ``paths``
     (the edges' quadratics through the last instants, the lift's ``lift``), the released
     elements' count in ``sc[S_K_ALPHA]`` widened to the zone's spacing however far the edge
-    recedes (``edges[E_SPACING]`` inf: never), and ``(lo, hi)``, the elements from the edge's
-    lower position to past the zone end's highest (the centre's alone without a zone);
+    recedes (``edges[E_SPACING]`` inf: never) up to ``edges[E_MOST_RELEASED]``, and ``(lo,
+    hi)``, the elements from the edge's lower position to past the zone end's highest (the
+    centre's alone without a zone);
     ``hi`` is -1 where that reaches the archived elements (``sc[S_LIVE_END]``): they must
     come back first."""
     _quadratic(edges[E_ALPHA_PREV], edges[E_ALPHA], alpha, edges[E_R], paths[0])
@@ -1011,8 +1012,8 @@ def trial_ranges(alpha, beta, xi, n_all, edges, lift, paths, sc):
     else:
         hi = lo + 1 if n_all and xi[0] == 0.0 and lo == 0 else lo
     if alpha < edges[E_ALPHA]:
-        sc[S_K_ALPHA] = max(int(sc[S_K_ALPHA]),
-                            int(math.ceil((edges[E_ALPHA] - alpha) / edges[E_SPACING])))
+        sc[S_K_ALPHA] = max(int(sc[S_K_ALPHA]), int(math.ceil(min(
+            (edges[E_ALPHA] - alpha) / edges[E_SPACING], edges[E_MOST_RELEASED]))))
     return lo, hi
 
 

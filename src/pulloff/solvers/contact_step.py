@@ -139,14 +139,16 @@ class Step:
 
     @property
     def edges(self) -> np.ndarray:
-        """The edges now and one step earlier, the steps' ratio and the released elements'
-        spacing (inf where the step places its own): ``kernels.contact.trial_ranges``'s."""
+        """The edges now and one step earlier, the steps' ratio, the released elements'
+        spacing and their largest count (inf where the step places its own):
+        ``kernels.contact.trial_ranges``'s."""
         if self._edges is None:
             now, before, nan = self.now, self.before, math.nan
             self._edges = np.array([
                 now.alpha, now.beta, before.alpha if before is not None else nan,
                 before.beta if before is not None else nan, nan if self.r is None else self.r,
-                math.inf if self.fresh else self.s.spacing(now)])
+                math.inf if self.fresh else self.s.spacing(now),
+                math.inf if self.fresh else self.s.most_released])
         return self._edges
 
     @property
