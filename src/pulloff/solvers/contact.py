@@ -54,6 +54,35 @@ CONTROLLED = ("t_detach", "h_detach", "F_total_detach", "F_contact_detach", "t_s
               "h_jump_in", "F_jump_out", "h_jump_out", "energy_dissipated")
 
 
+def _pull_problems(scene) -> list[str]:
+    """The refusals of a flat punch's pull: lifted past its onset at ``t = 0``, bonded
+    beyond the face's strength at ``t = 0``, a near-elastic Kelvin-Voigt face."""
+    out = []
+    lifted = _lifted_past_the_onset(scene)
+    if lifted is not None:
+        out.append(problem_line(
+            "loading.h0", scene.loading.h0, f"lifted past the onset at t = 0 (the gap at "
+            f"the zone end is {lifted:.6g} delta with the bond pinned): the contact "
+            "stepper meets the onset as the gap reaching delta from below and would run "
+            "on without it " + ("(the edge quadrature takes such pulls)"
+                                if scene.loading.kind == "constant_velocity" else
+                                "(start below the onset and lift with a speed segment)")))
+    near = _near_elastic_face(scene)
+    if near is not None:
+        out.append(problem_line(
+            "material.eta", scene.material.eta, f"a Kelvin-Voigt face whose creep time "
+            f"eta / G is {near:.2g} of the pull's time unit delta / v (below "
+            f"{NEAR_ELASTIC_FACE:g}): the contact stepper's zone alone, released from the "
+            "face, jumps out within a few creep times instead of following its branch "
+            "(the edge quadrature, the default, runs such faces)"))
+    beyond = _bonded_beyond_strength(scene)
+    if beyond is not None:
+        out.append(problem_line(
+            "loading.v", scene.loading.v, f"the bond needs {beyond:.6g} times the face's "
+            "strength at t = 0: the contact stepper finds no onset there"))
+    return out
+
+
 #: A Kelvin-Voigt face's creep time ``eta / G`` over the pull's time unit ``delta / v`` below
 #: which the contact stepper is refused: its zone alone, released from the face, jumps out
 #: within a few creep times where the edge quadrature marches it to a collapse ~60 creep
@@ -195,29 +224,7 @@ class ContactSolver(Solver):
             out.append(problem_line(
                 "output.snapshots", list(scene.output.snapshots), "the contact solver stores "
                 "no displacement profiles yet"))
-        lifted = _lifted_past_the_onset(scene)
-        if lifted is not None:
-            out.append(problem_line(
-                "loading.h0", scene.loading.h0, f"lifted past the onset at t = 0 (the gap at "
-                f"the zone end is {lifted:.6g} delta with the bond pinned): the contact "
-                "stepper meets the onset as the gap reaching delta from below and would run "
-                "on without it " + ("(the edge quadrature takes such pulls)"
-                                    if scene.loading.kind == "constant_velocity" else
-                                    "(start below the onset and lift with a speed segment)")))
-        near = _near_elastic_face(scene)
-        if near is not None:
-            out.append(problem_line(
-                "material.eta", scene.material.eta, f"a Kelvin-Voigt face whose creep time "
-                f"eta / G is {near:.2g} of the pull's time unit delta / v (below "
-                f"{NEAR_ELASTIC_FACE:g}): the contact stepper's zone alone, released from the "
-                "face, jumps out within a few creep times instead of following its branch "
-                "(the edge quadrature, the default, runs such faces)"))
-        beyond = _bonded_beyond_strength(scene)
-        if beyond is not None:
-            out.append(problem_line(
-                "loading.v", scene.loading.v, f"the bond needs {beyond:.6g} times the face's "
-                "strength at t = 0: the contact stepper finds no onset there"))
-        return out + stepper_settings(scene, "contact")
+        return out + _pull_problems(scene) + stepper_settings(scene, "contact")
 
     def solve(self, scene, observers) -> Result:
         wall = time.perf_counter()
