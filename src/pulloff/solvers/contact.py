@@ -93,25 +93,40 @@ def _pull_problems(scene) -> list[str]:
 #: 1.4e-7), within 8e-9 at 2e-4. (At 2e-4 and rtol 1e-3 the first scene's three coarse
 #: levels agreed 1.5e-3 early, estimate 6.7e-5; at rtol 1e-4 and 1e-5 it is within them.)
 NEAR_ELASTIC_FACE = 1e-4
+#: Below this ``eta v / (G delta)`` (and above :data:`NEAR_ELASTIC_FACE`) a Kelvin-Voigt
+#: face's ladder starts at n = :data:`_NEAR_ELASTIC_FIRST_N`: from n = 8 its three coarse
+#: levels agreed on a jump out at rtol 1e-3, 1.5e-3, 2.9e-3 and 1.25e-3 early at 2e-4,
+#: 4e-4 (both 2e-4 m/s, sigma_c 3.5e5 Pa) and 2e-4 (2e-3 m/s, 6e5 Pa) with estimates of
+#: 6.7e-5 .. 2.7e-4; from n = 32 they are within 4.2e-5, 1.6e-5 and 1.3e-5 of the edge
+#: quadrature (estimates 1.1e-4 .. 1.8e-4; 0.9-3.4 s a run). From 8 they are within rtol at
+#: 6.7e-4 .. 2.7e-3 (5.8e-5 .. 3.7e-4).
+NEAR_ELASTIC_LADDER = 1e-3
+_NEAR_ELASTIC_FIRST_N = 32
 
 
-def _near_elastic_face(scene) -> float | None:
-    """``eta v / (G delta)`` of a rigid pull of a Kelvin-Voigt face below
-    :data:`NEAR_ELASTIC_FACE` (on a path, with its slowest pulling speed), else None."""
+def _face_creep_ratio(scene) -> float:
+    """``eta v / (G delta)`` of a rigid pull of a Kelvin-Voigt face (on a path, with its
+    slowest pulling speed); inf for any other scene."""
     material, loading = scene.material, scene.loading
     if (scene.geometry.kind != "flat_punch" or scene.geometry.cohesive_zone != "internal"
             or material.kind != "kelvin_voigt" or material.G == 0.0
             or getattr(loading, "machine_stiffness", None) is not None):
-        return None
+        return math.inf
     if loading.kind == "constant_velocity":
         speeds = [loading.v] if scene.model.until == "separation" else []
     else:
         speeds = [segment.speed for segment in loading.segments
                   if segment.speed is not None and segment.speed > 0.0]
     if not speeds:
-        return None
+        return math.inf
     ratio = material.eta * min(speeds) / (material.G * scene.adhesion.delta)
-    return ratio if 0.0 < ratio < NEAR_ELASTIC_FACE else None
+    return ratio if ratio > 0.0 else math.inf
+
+
+def _near_elastic_face(scene) -> float | None:
+    """:func:`_face_creep_ratio` where below :data:`NEAR_ELASTIC_FACE`, else None."""
+    ratio = _face_creep_ratio(scene)
+    return ratio if ratio < NEAR_ELASTIC_FACE else None
 
 
 def _lifted_past_the_onset(scene) -> float | None:
@@ -234,8 +249,11 @@ class ContactSolver(Solver):
             with observers.progress(f"n = {n}", None) as update:
                 return run_level(scene, n, setup, update)
 
+        first = _FIRST_N[setup.flat]
+        if _face_creep_ratio(scene) < NEAR_ELASTIC_LADDER:
+            first = max(first, _NEAR_ELASTIC_FIRST_N)
         result = ladder.refine(
-            level, _controlled, scene.numerics.rtol, _FIRST_N[setup.flat], ORDER,
+            level, _controlled, scene.numerics.rtol, first, ORDER,
             can_refine=lambda run, n: 2 * len(run.rows) <= MAX_STEPS,
             interrupted=lambda run: getattr(run, "interrupted", False), extrapolated="measured",
             floor=_floor, first_order_max=_FIRST_ORDER_MAX)
