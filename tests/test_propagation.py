@@ -192,32 +192,6 @@ def test_a_receding_edge_releases_at_most_its_cap_in_one_step():
     assert stepper.most_released == contact_stepper.MOST_RELEASED * stepper.per_release
 
 
-def test_a_near_elastic_faces_ladder_starts_finer(monkeypatch):
-    """A Kelvin-Voigt face with ``eta v / (G delta)`` between ``NEAR_ELASTIC_FACE`` and
-    ``NEAR_ELASTIC_LADDER`` starts its ladder at n = 32: from n = 8 the three coarse levels
-    agreed on a zone alone jumping out at rtol 1e-3, 1.5e-3 early at 2e-4 (eta = 3 here,
-    estimate 6.7e-5); from 32, 4.2e-5 (estimate 1.8e-4). Other flat punches start at 8."""
-    firsts = {}
-
-    class Started(Exception):
-        pass
-
-    def refine(run, outputs, rtol, n_first, *args, **kwargs):
-        raise Started(n_first)
-
-    monkeypatch.setattr(contact.ladder, "refine", refine)
-    face = ["loading.v=2e-4", "adhesion.sigma_c=3.5e5", "model.until=separation",
-            "numerics.method=stepper"]
-    for eta in (3.0, 30.0):
-        scene = load_scene(CONFIGS / "finite_punch_internal.yaml",
-                           overrides=face + [f"material.eta={eta}"])
-        with pytest.raises(Started) as started:
-            contact.ContactSolver().solve(scene, solvers.Observers.for_scene(scene))
-        firsts[eta] = started.value.args[0]
-    assert firsts == {3.0: 32, 30.0: 8}
-    assert contact._face_creep_ratio(scene) == pytest.approx(2e-3)
-
-
 def test_finite_punch_force_never_exceeds_the_strength_limit():
     res = solvers.simulate(load_scene(CONFIGS / "finite_punch_internal.yaml"))
     p = res.problem
