@@ -55,8 +55,8 @@ CONTROLLED = ("t_detach", "h_detach", "F_total_detach", "F_contact_detach", "t_s
 
 
 def _pull_problems(scene) -> list[str]:
-    """The refusals of a flat punch's pull: lifted past its onset at ``t = 0``, bonded
-    beyond the face's strength at ``t = 0``, a near-elastic Kelvin-Voigt face."""
+    """The refusals of a flat punch's pull: lifted past its onset at ``t = 0``, a
+    near-elastic Kelvin-Voigt face, bonded beyond the face's strength at ``t = 0``."""
     out = []
     lifted = _lifted_past_the_onset(scene)
     if lifted is not None:
@@ -99,29 +99,23 @@ def _pull_problems(scene) -> list[str]:
 NEAR_ELASTIC_FACE = 3e-3
 
 
-def _face_creep_ratio(scene) -> float:
+def _near_elastic_face(scene) -> float | None:
     """``eta v / (G delta)`` of a rigid pull of a Kelvin-Voigt face (on a path, with its
-    slowest pulling speed); inf for any other scene."""
+    slowest pulling speed) where below :data:`NEAR_ELASTIC_FACE`, else None."""
     material, loading = scene.material, scene.loading
     if (scene.geometry.kind != "flat_punch" or scene.geometry.cohesive_zone != "internal"
             or material.kind != "kelvin_voigt" or material.G == 0.0
             or getattr(loading, "machine_stiffness", None) is not None):
-        return math.inf
+        return None
     if loading.kind == "constant_velocity":
         speeds = [loading.v] if scene.model.until == "separation" else []
     else:
         speeds = [segment.speed for segment in loading.segments
                   if segment.speed is not None and segment.speed > 0.0]
     if not speeds:
-        return math.inf
+        return None
     ratio = material.eta * min(speeds) / (material.G * scene.adhesion.delta)
-    return ratio if ratio > 0.0 else math.inf
-
-
-def _near_elastic_face(scene) -> float | None:
-    """:func:`_face_creep_ratio` where below :data:`NEAR_ELASTIC_FACE`, else None."""
-    ratio = _face_creep_ratio(scene)
-    return ratio if ratio < NEAR_ELASTIC_FACE else None
+    return ratio if 0.0 < ratio < NEAR_ELASTIC_FACE else None
 
 
 def _lifted_past_the_onset(scene) -> float | None:
